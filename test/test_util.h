@@ -1,0 +1,51 @@
+// Helpers shared by the tests.
+#pragma once
+
+#include <cstdlib>
+#include <filesystem>
+#include <optional>
+#include <string>
+
+namespace ret3d {
+namespace test {
+
+// The real KITTI-derived data of ../shared/data (never copied into the repository). RET3D_SHARED_DATA overrides the
+// location. nullopt when absent: the calling test then skips with GTEST_SKIP() << kSharedDataMissing.
+inline std::optional<std::string> sharedDataDir() {
+  namespace fs = std::filesystem;
+  if (const char* env = std::getenv("RET3D_SHARED_DATA")) {
+    if (fs::is_directory(env)) return std::string(env);
+    return std::nullopt;
+  }
+  const fs::path p = fs::path(RET3D_SOURCE_DIR) / ".." / "shared" / "data";
+  if (fs::is_directory(p)) return fs::canonical(p).string();
+  return std::nullopt;
+}
+
+inline constexpr const char* kSharedDataMissing =
+    "../shared/data (real KITTI-derived data) is absent; set RET3D_SHARED_DATA to its location to run this test";
+
+// A fresh empty temporary directory, removed by the destructor.
+class TempDir {
+ public:
+  TempDir() {
+    namespace fs = std::filesystem;
+    std::string tmpl = (fs::temp_directory_path() / "ret3d_test_XXXXXX").string();
+    char* p = mkdtemp(tmpl.data());
+    path_ = p ? std::string(p) : std::string();
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  const std::string& path() const { return path_; }
+  std::string operator/(const std::string& name) const { return path_ + "/" + name; }
+
+ private:
+  std::string path_;
+};
+
+}  // namespace test
+}  // namespace ret3d
