@@ -1,0 +1,164 @@
+#include "ret3d/bev/bev_encoder.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+namespace ret3d {
+
+int BevGeometry::width() const { return static_cast<int>(std::lround((x_max - x_min) / resolution)); }
+int BevGeometry::height() const { return static_cast<int>(std::lround((y_max - y_min) / resolution)); }
+
+void BevGeometry::validate() const {
+  auto fail = [&](const std::string& what) { throw std::invalid_argument("BEV geometry: " + what + " (" + describe() + ")"); };
+  if (!(resolution > 0) || !std::isfinite(resolution)) fail("resolution must be positive");
+  if (!(x_max > x_min)) fail("x_max must exceed x_min");
+  if (!(y_max > y_min)) fail("y_max must exceed y_min");
+  if (!(z_max > z_min)) fail("z_max must exceed z_min");
+  if (std::abs((x_max - x_min) / resolution - width()) > 1e-6)
+    fail("x extent is not a whole number of cells");
+  if (std::abs((y_max - y_min) / resolution - height()) > 1e-6)
+    fail("y extent is not a whole number of cells");
+}
+
+Eigen::Vector2d BevGeometry::metricToGrid(double x, double y) const {
+  return {(x - x_min) / resolution, (y - y_min) / resolution};
+}
+
+Eigen::Vector2d BevGeometry::gridToMetric(double u, double v) const {
+  return {x_min + u * resolution, y_min + v * resolution};
+}
+
+Eigen::Vector2d BevGeometry::metricToFeature(double x, double y, int stride) const {
+  return metricToGrid(x, y) / static_cast<double>(stride);
+}
+
+Eigen::Vector2d BevGeometry::featureToMetric(double u, double v, int stride) const {
+  return gridToMetric(u * stride, v * stride);
+}
+
+bool BevGeometry::cellOf(double x, double y, double z, int* u, int* v) const {
+  if (!(x >= x_min && x < x_max && y >= y_min && y < y_max && z >= z_min && z <= z_max)) return false;
+  const int cu = static_cast<int>((x - x_min) / resolution);
+  const int cv = static_cast<int>((y - y_min) / resolution);
+  if (cu < 0 || cu >= width() || cv < 0 || cv >= height()) return false;
+  *u = cu;
+  *v = cv;
+  return true;
+}
+
+bool BevGeometry::operator==(const BevGeometry& o) const {
+  return x_min == o.x_min && x_max == o.x_max && y_min == o.y_min && y_max == o.y_max && z_min == o.z_min &&
+         z_max == o.z_max && resolution == o.resolution;
+}
+
+std::string BevGeometry::describe() const {
+  std::ostringstream os;
+  os << "x [" << x_min << ", " << x_max << "] y [" << y_min << ", " << y_max << "] z [" << z_min << ", " << z_max
+     << "] res " << resolution << " (" << width() << " x " << height() << ")";
+  return os.str();
+}
+
+BevEncoder::BevEncoder(const BevEncoderOptions& options) : options_(options) {
+  options_.geometry.validate();
+  if (options_.threads < 1) throw std::invalid_argument("BEV encoder: threads must be >= 1");
+  if (!(options_.density_norm > 1.0)) throw std::invalid_argument("BEV encoder: density_norm must exceed 1");
+}
+
+BevImage BevEncoder::encode(const PointCloud& current, const PointCloud* previous,
+                            const Eigen::Isometry3d& prev_to_current) const {
+  BevImage out;
+  encode(current, previous, prev_to_current, &out);
+  return out;
+}
+
+namespace {
+
+// Accumulates one sweep into the rows [v_begin, v_end) of its three channels. A worker owns a band of rows (or a
+// whole sweep), so the threads never share a cell: no locks and no merge pass.
+void accumulateSweep(const PointCloud& cloud, const Eigen::Matrix<float, 3, 4>& T, bool transform,
+                     const BevGeometry& g, int v_begin, int v_end, float* height_ch, float* count_ch,
+                     float* intensity_ch) {
+  const int W = g.width(), H = g.height();
+  const float inv_span = static_cast<float>(1.0 / (g.z_max - g.z_min));
+  const float x_min = static_cast<float>(g.x_min), y_min = static_cast<float>(g.y_min);
+  const float z_min = static_cast<float>(g.z_min), z_max = static_cast<float>(g.z_max);
+  const float inv_res = static_cast<float>(1.0 / g.resolution);
+  for (const Point& p : cloud.points) {
+    float x = p.x, y = p.y, z = p.z;
+    if (transform) {
+      x = T(0, 0) * p.x + T(0, 1) * p.y + T(0, 2) * p.z + T(0, 3);
+      y = T(1, 0) * p.x + T(1, 1) * p.y + T(1, 2) * p.z + T(1, 3);
+      z = T(2, 0) * p.x + T(2, 1) * p.y + T(2, 2) * p.z + T(2, 3);
+    }
+    if (!(z >= z_min && z <= z_max)) continue;  // also drops NaN
+    const float fu = (x - x_min) * inv_res, fv = (y - y_min) * inv_res;
+    if (!(fu >= 0.0f && fv >= 0.0f)) continue;
+    const int u = static_cast<int>(fu), v = static_cast<int>(fv);
+    if (u >= W || v >= H || v < v_begin || v >= v_end) continue;
+    const std::size_t idx = static_cast<std::size_t>(v) * W + u;
+    const float h = (z - z_min) * inv_span;                        // LWD-3D eq. (1), normalised to [0, 1]
+    if (h > height_ch[idx]) height_ch[idx] = h;
+    count_ch[idx] += 1.0f;
+    const float inten = std::min(1.0f, std::max(0.0f, std::isfinite(p.intensity) ? p.intensity : 0.0f));
+    if (inten > intensity_ch[idx]) intensity_ch[idx] = inten;      // LWD-3D eq. (3)
+  }
+}
+
+}  // namespace
+
+void BevEncoder::encode(const PointCloud& current, const PointCloud* previous,
+                        const Eigen::Isometry3d& prev_to_current, BevImage* out) const {
+  const BevGeometry& g = options_.geometry;
+  const int H = g.height(), W = g.width();
+  out->channels = kChannels;
+  out->height = H;
+  out->width = W;
+  const std::size_t plane = static_cast<std::size_t>(H) * W;
+  out->data.assign(plane * kChannels, 0.0f);
+
+  const Eigen::Matrix<float, 3, 4> T = prev_to_current.matrix().topRows<3>().cast<float>();
+  const float inv_log_norm = static_cast<float>(1.0 / std::log(options_.density_norm));
+  float* base = out->data.data();
+
+  // Work items: (sweep, band of rows). With two threads and two sweeps each thread takes one whole sweep (no point
+  // is scanned twice); with one sweep the rows are split.
+  struct Item {
+    int sweep, v_begin, v_end;
+  };
+  const int threads = std::max(1, std::min(options_.threads, H));
+  const int sweeps = previous ? kSweeps : 1;
+  const int bands = std::max(1, threads / sweeps);
+  std::vector<Item> items;
+  for (int s = 0; s < sweeps; ++s)
+    for (int b = 0; b < bands; ++b) items.push_back({s, H * b / bands, H * (b + 1) / bands});
+
+  auto run = [&](const Item& it) {
+    const PointCloud* cloud = it.sweep == 0 ? &current : previous;
+    float* hc = base + plane * (kChannelsPerSweep * it.sweep + 0);
+    float* dc = base + plane * (kChannelsPerSweep * it.sweep + 1);
+    float* ic = base + plane * (kChannelsPerSweep * it.sweep + 2);
+    accumulateSweep(*cloud, T, it.sweep == 1, g, it.v_begin, it.v_end, hc, dc, ic);
+    // Counts -> LWD-3D eq. (2), read as min(1, log(N + 1) / log(64)) (the printed log((N+1)/64) is negative
+    // for every N < 63; MV3D's normalisation is meant).
+    const std::size_t end = static_cast<std::size_t>(it.v_end) * W;
+    for (std::size_t i = static_cast<std::size_t>(it.v_begin) * W; i < end; ++i)
+      if (dc[i] > 0) dc[i] = std::min(1.0f, std::log(dc[i] + 1.0f) * inv_log_norm);
+  };
+  auto worker = [&](int t) {
+    for (std::size_t i = t; i < items.size(); i += threads) run(items[i]);
+  };
+  if (threads == 1) {
+    worker(0);
+    return;
+  }
+  std::vector<std::thread> pool;
+  pool.reserve(threads - 1);
+  for (int t = 1; t < threads; ++t) pool.emplace_back(worker, t);
+  worker(0);
+  for (auto& th : pool) th.join();
+}
+
+}  // namespace ret3d
