@@ -1,0 +1,389 @@
+#include "ret3d/ros/conversions.h"
+
+#include <sensor_msgs/PointField.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+
+#include "ret3d/core/geometry.h"
+
+namespace ret3d {
+namespace {
+
+using sensor_msgs::PointField;
+
+constexpr bool kHostIsBigEndian = __BYTE_ORDER__ == __ORDER_BIG_ENDIAN__;
+
+std::size_t datatypeSize(std::uint8_t datatype) {
+  switch (datatype) {
+    case PointField::INT8:
+    case PointField::UINT8:
+      return 1;
+    case PointField::INT16:
+    case PointField::UINT16:
+      return 2;
+    case PointField::INT32:
+    case PointField::UINT32:
+    case PointField::FLOAT32:
+      return 4;
+    case PointField::FLOAT64:
+      return 8;
+    default:
+      return 0;
+  }
+}
+
+bool isFloat(std::uint8_t datatype) { return datatype == PointField::FLOAT32 || datatype == PointField::FLOAT64; }
+
+// Largest positive value of an integer datatype (the divisor of IntensityScaling::DatatypeRange).
+double datatypeMax(std::uint8_t datatype) {
+  switch (datatype) {
+    case PointField::INT8:
+      return std::numeric_limits<std::int8_t>::max();
+    case PointField::UINT8:
+      return std::numeric_limits<std::uint8_t>::max();
+    case PointField::INT16:
+      return std::numeric_limits<std::int16_t>::max();
+    case PointField::UINT16:
+      return std::numeric_limits<std::uint16_t>::max();
+    case PointField::INT32:
+      return std::numeric_limits<std::int32_t>::max();
+    case PointField::UINT32:
+      return std::numeric_limits<std::uint32_t>::max();
+    default:
+      return 1.0;
+  }
+}
+
+const char* datatypeName(std::uint8_t datatype) {
+  switch (datatype) {
+    case PointField::INT8:
+      return "int8";
+    case PointField::UINT8:
+      return "uint8";
+    case PointField::INT16:
+      return "int16";
+    case PointField::UINT16:
+      return "uint16";
+    case PointField::INT32:
+      return "int32";
+    case PointField::UINT32:
+      return "uint32";
+    case PointField::FLOAT32:
+      return "float32";
+    case PointField::FLOAT64:
+      return "float64";
+    default:
+      return "unknown";
+  }
+}
+
+template <typename T>
+T loadAs(const std::uint8_t* bytes) {
+  T v;
+  std::memcpy(&v, bytes, sizeof(T));
+  return v;
+}
+
+// One field of the message, read from a point's bytes as a double in host byte order.
+struct FieldReader {
+  std::string name;
+  std::uint32_t offset = 0;
+  std::uint8_t datatype = 0;
+  std::size_t size = 0;
+  bool swap = false;
+
+  double read(const std::uint8_t* point) const {
+    std::uint8_t b[8];
+    std::memcpy(b, point + offset, size);
+    if (swap) std::reverse(b, b + size);
+    switch (datatype) {
+      case PointField::INT8:
+        return loadAs<std::int8_t>(b);
+      case PointField::UINT8:
+        return loadAs<std::uint8_t>(b);
+      case PointField::INT16:
+        return loadAs<std::int16_t>(b);
+      case PointField::UINT16:
+        return loadAs<std::uint16_t>(b);
+      case PointField::INT32:
+        return loadAs<std::int32_t>(b);
+      case PointField::UINT32:
+        return loadAs<std::uint32_t>(b);
+      case PointField::FLOAT32:
+        return loadAs<float>(b);
+      case PointField::FLOAT64:
+        return loadAs<double>(b);
+      default:
+        return 0.0;
+    }
+  }
+};
+
+// The first of `names` present in the message, validated against point_step; nullopt when none is present.
+std::optional<FieldReader> findField(const sensor_msgs::PointCloud2& msg, std::initializer_list<const char*> names) {
+  for (const char* name : names) {
+    for (const auto& f : msg.fields) {
+      if (f.name != name) continue;
+      FieldReader r;
+      r.name = f.name;
+      r.offset = f.offset;
+      r.datatype = f.datatype;
+      r.size = datatypeSize(f.datatype);
+      r.swap = static_cast<bool>(msg.is_bigendian) != kHostIsBigEndian;
+      if (r.size == 0) {
+        throw std::invalid_argument("PointCloud2 field '" + f.name + "' has unknown datatype " +
+                                    std::to_string(static_cast<int>(f.datatype)));
+      }
+      if (static_cast<std::size_t>(f.offset) + r.size > msg.point_step) {
+        std::ostringstream oss;
+        oss << "PointCloud2 field '" << f.name << "' (" << datatypeName(f.datatype) << " at offset " << f.offset
+            << ") extends past point_step " << msg.point_step;
+        throw std::invalid_argument(oss.str());
+      }
+      return r;
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+PointCloud toCloud(const sensor_msgs::PointCloud2& msg, const CloudConversionOptions& options,
+                   CloudConversionReport* report) {
+  CloudConversionReport local_report;
+  CloudConversionReport& rep = report ? *report : local_report;
+  rep = CloudConversionReport{};
+
+  PointCloud cloud;
+  const std::size_t width = msg.width, height = msg.height;
+  const std::size_t n = width * height;
+  rep.input_points = n;
+  // An empty message (even a default-constructed one without fields) is a valid empty scan.
+  if (n == 0) return cloud;
+
+  if (msg.point_step == 0)
+    throw std::invalid_argument("PointCloud2 has point_step 0 with " + std::to_string(n) + " points");
+  if (msg.row_step < width * msg.point_step) {
+    std::ostringstream oss;
+    oss << "PointCloud2 row_step " << msg.row_step << " is smaller than width * point_step = " << width << " * "
+        << msg.point_step;
+    throw std::invalid_argument(oss.str());
+  }
+  const std::size_t needed = msg.row_step * (height - 1) + width * msg.point_step;
+  if (msg.data.size() < needed) {
+    std::ostringstream oss;
+    oss << "PointCloud2 data holds " << msg.data.size() << " bytes but " << width << " x " << height
+        << " points (point_step " << msg.point_step << ", row_step " << msg.row_step << ") need " << needed;
+    throw std::invalid_argument(oss.str());
+  }
+  if (options.intensity_scaling == IntensityScaling::FixedScale && !(options.intensity_scale > 0.0)) {
+    throw std::invalid_argument("CloudConversionOptions::intensity_scale must be > 0 for FixedScale");
+  }
+
+  const auto fx = findField(msg, {"x"});
+  const auto fy = findField(msg, {"y"});
+  const auto fz = findField(msg, {"z"});
+  if (!fx || !fy || !fz) {
+    std::string present;
+    for (const auto& f : msg.fields) present += (present.empty() ? "" : ", ") + f.name;
+    throw std::invalid_argument("PointCloud2 lacks field '" +
+                                std::string(!fx   ? "x"
+                                            : !fy ? "y"
+                                                  : "z") +
+                                "' (fields: " + (present.empty() ? "none" : present) + ")");
+  }
+  const auto fi = findField(msg, {"intensity", "i", "reflectivity"});
+  const auto fring = options.keep_ring ? findField(msg, {"ring"}) : std::nullopt;
+  const auto ftime = options.keep_time ? findField(msg, {"time", "t", "timestamp"}) : std::nullopt;
+  if (fi) {
+    rep.intensity_field = fi->name;
+  } else {
+    rep.warnings.push_back("no intensity field (intensity, i or reflectivity): intensities set to 0");
+  }
+  if (fring) rep.has_ring = true;
+  if (ftime) rep.time_field = ftime->name;
+
+  cloud.points.reserve(n);
+  std::vector<double> times;
+  if (ftime) times.reserve(n);
+  if (fring) cloud.ring.reserve(n);
+
+  double raw_max = 0.0;
+  for (std::size_t row = 0; row < height; ++row) {
+    const std::uint8_t* row_ptr = msg.data.data() + row * msg.row_step;
+    for (std::size_t col = 0; col < width; ++col) {
+      const std::uint8_t* p = row_ptr + col * msg.point_step;
+      const double x = fx->read(p), y = fy->read(p), z = fz->read(p);
+      if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) {
+        ++rep.dropped_nonfinite;
+        continue;
+      }
+      Point pt;
+      pt.x = static_cast<float>(x);
+      pt.y = static_cast<float>(y);
+      pt.z = static_cast<float>(z);
+      if (fi) {
+        const double v = fi->read(p);
+        // A non-finite intensity is a sensor glitch on a valid point: keep the point, with intensity 0.
+        pt.intensity = std::isfinite(v) ? static_cast<float>(v) : 0.0f;
+        raw_max = std::max(raw_max, static_cast<double>(pt.intensity));
+      }
+      cloud.points.push_back(pt);
+      if (fring) {
+        const double r = fring->read(p);
+        cloud.ring.push_back(static_cast<std::uint16_t>(std::clamp(std::isfinite(r) ? r : 0.0, 0.0, 65535.0)));
+      }
+      if (ftime) {
+        const double t = ftime->read(p);
+        times.push_back(std::isfinite(t) ? t : 0.0);
+      }
+    }
+  }
+  rep.output_points = cloud.points.size();
+  rep.raw_intensity_max = raw_max;
+
+  if (fi) {
+    double divisor = 1.0;
+    switch (options.intensity_scaling) {
+      case IntensityScaling::Auto:
+        divisor = isFloat(fi->datatype) ? (raw_max > 1.0 ? raw_max : 1.0) : datatypeMax(fi->datatype);
+        break;
+      case IntensityScaling::DatatypeRange:
+        divisor = isFloat(fi->datatype) ? 1.0 : datatypeMax(fi->datatype);
+        break;
+      case IntensityScaling::ObservedMax:
+        divisor = raw_max > 0.0 ? raw_max : 1.0;
+        break;
+      case IntensityScaling::FixedScale:
+        divisor = options.intensity_scale;
+        break;
+    }
+    rep.intensity_divisor = divisor;
+    const float inv = static_cast<float>(1.0 / divisor);
+    for (auto& pt : cloud.points) pt.intensity = std::clamp(pt.intensity * inv, 0.0f, 1.0f);
+  }
+
+  if (ftime) {
+    // Integer times are nanoseconds (Ouster `t`), float times seconds (velodyne `time`).
+    const double to_seconds = isFloat(ftime->datatype) ? 1.0 : 1e-9;
+    double origin = 0.0;
+    // Absolute stamps (e.g. Hesai's float64 `timestamp`) become offsets within the sweep.
+    const bool absolute = std::any_of(times.begin(), times.end(), [&](double t) { return t * to_seconds > 1e6; });
+    if (absolute) {
+      origin = msg.header.stamp.toSec();
+      if (origin == 0.0) origin = *std::min_element(times.begin(), times.end()) * to_seconds;
+    }
+    cloud.time.resize(times.size());
+    for (std::size_t i = 0; i < times.size(); ++i) cloud.time[i] = static_cast<float>(times[i] * to_seconds - origin);
+  }
+  return cloud;
+}
+
+sensor_msgs::PointCloud2 toPointCloud2(const PointCloud& cloud, const std_msgs::Header& header) {
+  // The velodyne driver's packed layout (velodyne_pointcloud's PointXYZIR plus time).
+  constexpr std::uint32_t kStep = 22;
+  sensor_msgs::PointCloud2 msg;
+  msg.header = header;
+  msg.height = 1;
+  msg.width = static_cast<std::uint32_t>(cloud.size());
+  msg.is_bigendian = kHostIsBigEndian;
+  msg.is_dense = true;
+  msg.point_step = kStep;
+  msg.row_step = kStep * msg.width;
+  const auto addField = [&](const char* name, std::uint32_t offset, std::uint8_t datatype) {
+    PointField f;
+    f.name = name;
+    f.offset = offset;
+    f.datatype = datatype;
+    f.count = 1;
+    msg.fields.push_back(f);
+  };
+  addField("x", 0, PointField::FLOAT32);
+  addField("y", 4, PointField::FLOAT32);
+  addField("z", 8, PointField::FLOAT32);
+  addField("intensity", 12, PointField::FLOAT32);
+  addField("ring", 16, PointField::UINT16);
+  addField("time", 18, PointField::FLOAT32);
+
+  msg.data.resize(static_cast<std::size_t>(msg.row_step));
+  const bool has_ring = cloud.hasRing(), has_time = cloud.hasTime();
+  std::uint8_t* out = msg.data.data();
+  for (std::size_t i = 0; i < cloud.size(); ++i, out += kStep) {
+    const Point& p = cloud.points[i];
+    const float xyzi[4] = {p.x, p.y, p.z, p.intensity};
+    const std::uint16_t ring = has_ring ? cloud.ring[i] : 0;
+    const float t = has_time ? cloud.time[i] : 0.0f;
+    std::memcpy(out, xyzi, sizeof(xyzi));
+    std::memcpy(out + 16, &ring, sizeof(ring));
+    std::memcpy(out + 18, &t, sizeof(t));
+  }
+  return msg;
+}
+
+ret3d::Object3D toMsg(const Box& box) {
+  ret3d::Object3D m;
+  m.track_id = box.track_id;
+  m.label = static_cast<std::uint8_t>(box.label);
+  m.score = box.score;
+  m.pose.position.x = box.x;
+  m.pose.position.y = box.y;
+  m.pose.position.z = box.z;
+  // Rotation about z by yaw: q = (cos(yaw/2), 0, 0, sin(yaw/2)).
+  m.pose.orientation.w = std::cos(0.5 * box.yaw);
+  m.pose.orientation.x = 0.0;
+  m.pose.orientation.y = 0.0;
+  m.pose.orientation.z = std::sin(0.5 * box.yaw);
+  m.dimensions.x = box.length;
+  m.dimensions.y = box.width;
+  m.dimensions.z = box.height;
+  m.velocity.x = box.vx;
+  m.velocity.y = box.vy;
+  m.velocity.z = 0.0;
+  m.num_points = box.num_points;
+  return m;
+}
+
+Box fromMsg(const ret3d::Object3D& m) {
+  Box b;
+  b.x = m.pose.position.x;
+  b.y = m.pose.position.y;
+  b.z = m.pose.position.z;
+  const auto& q = m.pose.orientation;
+  // Yaw of a general quaternion (z-y-x Euler convention); exact for the pure rotations about z that toMsg writes.
+  b.yaw = wrapAngle(std::atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z)));
+  b.length = m.dimensions.x;
+  b.width = m.dimensions.y;
+  b.height = m.dimensions.z;
+  b.vx = m.velocity.x;
+  b.vy = m.velocity.y;
+  b.score = m.score;
+  b.label = m.label <= static_cast<std::uint8_t>(ObjectClass::Cyclist) ? static_cast<ObjectClass>(m.label)
+                                                                       : ObjectClass::Unknown;
+  b.track_id = m.track_id;
+  b.num_points = m.num_points;
+  return b;
+}
+
+ret3d::Object3DArray toMsg(const std::vector<Box>& boxes, const std_msgs::Header& header) {
+  ret3d::Object3DArray msg;
+  msg.header = header;
+  msg.objects.reserve(boxes.size());
+  for (const Box& b : boxes) msg.objects.push_back(toMsg(b));
+  return msg;
+}
+
+std::vector<Box> fromMsg(const ret3d::Object3DArray& msg) {
+  std::vector<Box> boxes;
+  boxes.reserve(msg.objects.size());
+  for (const auto& o : msg.objects) boxes.push_back(fromMsg(o));
+  return boxes;
+}
+
+}  // namespace ret3d
