@@ -1,5 +1,8 @@
 // KITTI object and tracking layouts: velodyne scans, labels, calibration, poses and OXTS; read and write.
-// A malformed line throws ParseError naming the file, the line number and the field.
+// A malformed line throws ParseError "FILE:LINE: field 'NAME': problem" (wrong field count, a value that is not a
+// finite number, a non-integer where KITTI has an integer); a problem with the whole file reads "FILE: problem".
+// A file that cannot be opened or written throws std::runtime_error naming it (ParseError is a runtime_error too).
+// Empty lines are skipped everywhere. Numbers are read and written independently of the C locale.
 #pragma once
 
 #include <array>
@@ -22,13 +25,17 @@ class ParseError : public std::runtime_error {
 };
 
 // ---- velodyne scans: N x 4 float32 (x, y, z, reflectance in [0, 1]) ----
+// A size that is not a multiple of 16 bytes is a ParseError naming the file. Points with a non-finite coordinate are
+// dropped (with a warning); a NaN reflectance becomes 0; reflectance above 1 (a 0-255 file from another tool) is
+// scaled by 1/255 (by 1/max when above 255, with a warning), then clamped to [0, 1].
 PointCloud readVelodyne(const std::string& path);
 void writeVelodyne(const std::string& path, const PointCloud& cloud);
 
 // ---- labels ----
 // One label line in KITTI camera coordinates. Object layout (label_2):
 //   type truncated occluded alpha x1 y1 x2 y2 h w l x y z rotation_y [score]
-// Tracking layout (label_02): frame track_id, then the same fields.
+// Tracking layout (label_02): frame track_id, then the same fields (truncated an integer level there).
+// Writers use fixed notation with 6 decimals, which the KITTI devkits read; score is written only when present.
 struct Label {
   int frame = -1;            // tracking layout only
   int track_id = -1;         // tracking layout only (-1 for DontCare)
@@ -56,7 +63,14 @@ struct Calibration {
   Eigen::Matrix3d R0_rect = Eigen::Matrix3d::Identity();
   Eigen::Isometry3d velo_to_cam = Eigen::Isometry3d::Identity();  // Tr_velo_to_cam
   Eigen::Isometry3d imu_to_velo = Eigen::Isometry3d::Identity();  // Tr_imu_to_velo (identity when absent)
-  std::array<Eigen::Matrix<double, 3, 4>, 4> P{};                  // P0..P3 (P[2] == P2)
+  std::array<Eigen::Matrix<double, 3, 4>, 4> P{{Eigen::Matrix<double, 3, 4>::Identity(),  // P0..P3 (P[2] == P2)
+                                                Eigen::Matrix<double, 3, 4>::Identity(),
+                                                Eigen::Matrix<double, 3, 4>::Identity(),
+                                                Eigen::Matrix<double, 3, 4>::Identity()}};
+
+  // R0_rect * Tr_velo_to_cam as a 4x4 affine matrix (LiDAR -> rectified camera). Used as given, not re-orthonormalised,
+  // so veloToRect and rectToVelo (its general inverse) are exact inverses.
+  Eigen::Matrix4d veloToRectMatrix() const;
 
   // Point in LiDAR frame -> rectified camera frame: R0_rect * Tr_velo_to_cam * p.
   Eigen::Vector3d veloToRect(const Eigen::Vector3d& p) const;
@@ -67,17 +81,28 @@ struct Calibration {
 // Reads both key styles: object ("P2: ...", "R0_rect: ...", "Tr_velo_to_cam: ...") and tracking
 // ("P2 ...", "R_rect ...", "Tr_velo_cam ...").
 Calibration readCalibration(const std::string& path);
+// P2, R0_rect (R_rect) and Tr_velo_to_cam (Tr_velo_cam) are required: a missing one is a ParseError naming the file
+// and the key. Tr_imu_to_velo (Tr_imu_velo) is optional (identity); P0, P1, P3 are optional (zero when absent).
 // Writes the object key style, which readCalibration reads back.
 void writeCalibration(const std::string& path, const Calibration& calib);
 // A KITTI-like calibration (the values of the tracking benchmark's sequence 0000), used by the simulator.
 Calibration defaultCalibration();
 
 // ---- label <-> box ----
-// Camera label (bottom centre, rotation_y) -> LiDAR-frame box (geometric centre, yaw). Type maps through
-// classFromName (others become Unknown); track id kept when >= 0; score kept when present.
+// Track ids: KITTI tracking ids start at 0 (-1 = none, e.g. DontCare) while Box::track_id 0 means none, so
+//   Box::track_id = kitti track_id + 1 when kitti track_id >= 0, else 0;   kitti track_id = Box::track_id - 1, or -1.
+// Geometry: the box centre is rectToVelo(x, y - h/2, z) (camera y points down); length = l, width = w, height = h;
+// yaw is the direction of the heading (cos ry, 0, -sin ry), rotated into the LiDAR frame, projected on the ground
+// plane: atan2(dy, dx), wrapped to (-pi, pi]. boxToLabel inverts this exactly (label -> box -> label to ~1e-12).
+//
+// Camera label -> LiDAR-frame box. Type maps through classFromName (others, e.g. Van or DontCare, become Unknown:
+// check the type first when that matters); score kept when present (else the Box default 1).
 Box labelToBox(const Label& label, const Calibration& calib);
-// LiDAR-frame box -> camera label. Fills h w l x y z rotation_y, alpha, the 2D box (projected 3D corners, clipped to
-// the image when image_size is given), type from the class, track id and score. truncated/occluded are left 0.
+// LiDAR-frame box -> camera label. Fills h w l x y z rotation_y, alpha = wrapAngle(rotation_y - atan2(x, z)) (KITTI's
+// observation angle; it matches the real labels), the 2D box (the projection of the 3D box's part at least 0.1 m in
+// front of the camera, clipped to [0, width-1] x [0, height-1] when image_size is given; {0, 0, 0, 0} when nothing is
+// in front), type from the class ("Misc" for Unknown), track id (mapping above), score. truncated/occluded are left 0,
+// frame -1.
 Label boxToLabel(const Box& box, const Calibration& calib,
                  const std::optional<Eigen::Vector2d>& image_size = Eigen::Vector2d(1242, 375));
 
@@ -85,7 +110,9 @@ Label boxToLabel(const Box& box, const Calibration& calib,
 // pose/SSSS.txt: one row-major 3x4 camera-to-world matrix per line (KITTI odometry convention).
 std::vector<Eigen::Isometry3d> readPoses(const std::string& path);
 void writePoses(const std::string& path, const std::vector<Eigen::Isometry3d>& poses);
-// Camera poses -> LiDAR poses in the first LiDAR frame: T_velo0_velo_t = Tr^-1 * T_cam0_cam_t * Tr.
+// Camera poses -> LiDAR poses in the first LiDAR frame: T_velo0_velo_t = Tr^-1 * T_cam0_cam0^-1 * T_cam0_cam_t * Tr,
+// where Tr = R0_rect * Tr_velo_to_cam (nearest rigid transform): KITTI odometry poses are those of the *rectified* left
+// camera (the odometry calib's Tr already includes R0_rect). Relative to the first pose, so the result starts at identity.
 std::vector<Eigen::Isometry3d> cameraPosesToLidar(const std::vector<Eigen::Isometry3d>& cam_poses,
                                                   const Calibration& calib);
 
@@ -103,17 +130,19 @@ struct OxtsRecord {
 std::vector<OxtsRecord> readOxts(const std::string& path);
 void writeOxts(const std::string& path, const std::vector<OxtsRecord>& records);
 // IMU poses relative to the first record (Mercator projection with the first latitude's scale, as the KITTI devkit),
-// then moved into the LiDAR frame with Tr_imu_to_velo: T_velo0_velo_t.
+// then moved into the LiDAR frame with Tr_imu_to_velo: T_velo0_velo_t = Ti * T_imu0_imu_t * Ti^-1 (Ti = Tr_imu_to_velo).
+// Rotation R = Rz(yaw) * Ry(pitch) * Rx(roll); yaw 0 points east.
 std::vector<Eigen::Isometry3d> oxtsToLidarPoses(const std::vector<OxtsRecord>& records, const Calibration& calib);
 
 // ---- dataset layouts ----
 // Tracking layout: ROOT/training/{velodyne/SSSS/FFFFFF.bin, label_02/SSSS.txt, calib/SSSS.txt, pose/SSSS.txt,
-// oxts/SSSS.txt}. ROOT may also be the training folder itself.
+// oxts/SSSS.txt}. ROOT may also be the training folder itself. The constructors throw std::runtime_error when ROOT is
+// not a folder.
 class TrackingDataset {
  public:
   explicit TrackingDataset(const std::string& root);
   const std::string& dir() const { return dir_; }  // the folder holding velodyne/, label_02/, ...
-  std::vector<std::string> sequences() const;      // "0000", ... sorted, from velodyne/ or label_02/
+  std::vector<std::string> sequences() const;      // "0000", ... sorted: velodyne/ subfolders and label_02/ files
   std::vector<int> frames(const std::string& seq) const;  // frame indices with a scan, sorted
   std::string velodynePath(const std::string& seq, int frame) const;
   std::string labelPath(const std::string& seq) const;
@@ -133,7 +162,7 @@ class ObjectDataset {
  public:
   explicit ObjectDataset(const std::string& root);
   const std::string& dir() const { return dir_; }
-  std::vector<std::string> frames() const;  // "000000", ... sorted, from velodyne/ or label_2/
+  std::vector<std::string> frames() const;  // "000000", ... sorted: velodyne/*.bin and label_2/*.txt
   std::string velodynePath(const std::string& frame) const;
   std::string labelPath(const std::string& frame) const;
   std::string calibPath(const std::string& frame) const;

@@ -1,0 +1,73 @@
+// Ego poses in the KITTI odometry convention (pose/SSSS.txt: one row-major 3x4 camera-to-world matrix per frame),
+// and their conversion to LiDAR poses.
+#include <fstream>
+
+#include "ret3d/io/kitti.h"
+#include "rigid.h"
+#include "text_fields.h"
+
+namespace ret3d {
+namespace kitti {
+namespace {
+
+constexpr const char* kPoseFields[12] = {"r11", "r12", "r13", "tx", "r21", "r22",
+                                         "r23", "ty",  "r31", "r32", "r33", "tz"};
+
+}  // namespace
+
+std::vector<Eigen::Isometry3d> readPoses(const std::string& path) {
+  std::ifstream in = detail::openForRead(path);
+  std::vector<Eigen::Isometry3d> poses;
+  std::string line;
+  int line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    const auto f = detail::splitFields(line);
+    if (f.empty()) continue;
+    const detail::Where where{path, line_no};
+    if (f.size() < 12) {
+      detail::fail(where, kPoseFields[f.size()],
+                   "missing; the line has " + std::to_string(f.size()) + " numbers (a 3x4 pose has 12)");
+    }
+    if (f.size() > 12) {
+      detail::fail(where, kPoseFields[11],
+                   "followed by " + std::to_string(f.size() - 12) + " extra number(s) (a 3x4 pose has 12)");
+    }
+    Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+    for (int i = 0; i < 12; ++i) t.matrix()(i / 4, i % 4) = detail::parseDouble(f[i], where, kPoseFields[i]);
+    poses.push_back(t);
+  }
+  return poses;
+}
+
+void writePoses(const std::string& path, const std::vector<Eigen::Isometry3d>& poses) {
+  std::string s;
+  for (const auto& t : poses) {
+    for (int i = 0; i < 12; ++i) {
+      if (i) s += ' ';
+      detail::appendScientific(s, t.matrix()(i / 4, i % 4), 12);
+    }
+    s += '\n';
+  }
+  std::ofstream out = detail::openForWrite(path);
+  out << s;
+  detail::closeWritten(out, path);
+}
+
+std::vector<Eigen::Isometry3d> cameraPosesToLidar(const std::vector<Eigen::Isometry3d>& cam_poses,
+                                                  const Calibration& calib) {
+  std::vector<Eigen::Isometry3d> out;
+  if (cam_poses.empty()) return out;
+  // KITTI odometry poses are those of the rectified left camera (their calib's Tr already includes R0_rect), so the
+  // camera-from-LiDAR transform here is R0_rect * Tr_velo_to_cam, made exactly rigid.
+  const Eigen::Isometry3d cam_from_velo = detail::nearestIsometry(calib.veloToRectMatrix());
+  const Eigen::Isometry3d velo_from_cam = cam_from_velo.inverse(Eigen::Isometry);
+  // Relative to the first pose, so the result starts at identity even when the file's first pose is not.
+  const Eigen::Isometry3d first_inv = cam_poses.front().inverse(Eigen::Isometry);
+  out.reserve(cam_poses.size());
+  for (const auto& p : cam_poses) out.push_back(velo_from_cam * first_inv * p * cam_from_velo);
+  return out;
+}
+
+}  // namespace kitti
+}  // namespace ret3d
