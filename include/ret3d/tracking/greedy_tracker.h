@@ -1,0 +1,83 @@
+// CenterPoint's greedy tracker (Yin, Zhou, Kraehenbuehl, CVPR 2021, §3 "Tracking"), the tracker Ret3D builds its
+// object sequences with (Ret3D §3.3), run in a fixed frame so that ego motion does not move static objects.
+//
+// Per frame and per class: each detection's centre is moved back by its velocity times the time since the last frame
+// and matched to the tracks' centres by BEV distance within a class gate, greedily in descending score (or optimally,
+// Hungarian). Matched tracks take the detection; unmatched detections scoring at least birth_score start tracks with
+// fresh ids; unmatched tracks coast on their velocity for up to max_age frames without being output.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "ret3d/core/types.h"
+#include "ret3d/tracking/track_history.h"
+#include "ret3d/tracking/tracker_options.h"
+
+namespace ret3d {
+
+class GreedyTracker {
+ public:
+  // Throws std::invalid_argument for invalid options (see validate()).
+  explicit GreedyTracker(const TrackerOptions& options);
+
+  // One frame: detections in the sensor frame at `stamp` (s), with the sensor's pose in the fixed frame. Returns the
+  // tracked boxes of this frame in the sensor frame, in the detections' order: each a detection as given (all its
+  // fields kept) with track_id > 0 set; when the detection carried no velocity (or use_detection_velocity is off),
+  // (vx, vy) are the track's estimated velocity (zero until two observations). Detections below score_threshold,
+  // of the Unknown class, or with non-finite fields are skipped; unmatched ones below birth_score are not output.
+  // A stamp before the previous one (a bag loop) or more than max_time_gap after it resets the tracker first, with
+  // one log line; track ids keep counting, so they are never reused within the tracker's life.
+  std::vector<Box> update(const std::vector<Box>& detections, double stamp, const Eigen::Isometry3d& sensor_to_fixed);
+
+  // Forgets all tracks (ids keep counting).
+  void reset();
+
+  // The history of a live track (oldest first, the last entry being this frame's detection when it was matched),
+  // moved into the sensor frame of the last update with time offsets relative to its stamp. Empty for an unknown id.
+  std::vector<TimedBox> history(std::uint32_t track_id) const;
+  // The stored history (fixed frame) of a live track, nullptr for an unknown id.
+  const TrackHistory* findHistory(std::uint32_t track_id) const;
+
+  // Live tracks, coasting ones included.
+  std::size_t numTracks() const { return tracks_.size(); }
+  // Resets caused by time jumps or gaps since construction.
+  std::size_t numResets() const { return num_resets_; }
+  // The largest id handed out so far (0 before the first track).
+  std::uint32_t lastId() const { return next_id_ - 1; }
+  const TrackerOptions& options() const { return options_; }
+
+ private:
+  struct Track {
+    std::uint32_t id = 0;
+    ObjectClass label = ObjectClass::Unknown;
+    Eigen::Vector3d position = Eigen::Vector3d::Zero();  // fixed frame: last matched centre, advanced while coasting
+    Eigen::Vector2d velocity = Eigen::Vector2d::Zero();  // fixed frame, m/s
+    bool velocity_known = false;
+    double last_seen = 0.0;  // stamp of the last match
+    int misses = 0;          // consecutive frames without a match
+    TrackHistory history;
+    explicit Track(std::size_t capacity) : history(capacity) {}
+  };
+  struct Candidate;  // a detection prepared for matching (fixed frame)
+
+  void matchClass(ObjectClass label, const std::vector<Candidate>& dets, double dt, double now,
+                  std::vector<int>& det_to_track);
+  // Least-squares velocity over the last velocity_window centres of the history plus `current`; false if too few.
+  bool estimateVelocity(const TrackHistory& history, const Eigen::Vector3d& current, double stamp,
+                        Eigen::Vector2d& velocity) const;
+
+  TrackerOptions options_;
+  std::vector<Track> tracks_;
+  std::uint32_t next_id_ = 1;
+  bool has_stamp_ = false;
+  double last_stamp_ = 0.0;
+  Eigen::Isometry3d last_sensor_to_fixed_ = Eigen::Isometry3d::Identity();
+  std::size_t num_resets_ = 0;
+  bool warned_unknown_class_ = false;
+};
+
+}  // namespace ret3d
