@@ -1,0 +1,215 @@
+#include "ret3d/eval/waymo_ap.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "ret3d/core/geometry.h"
+#include "parallel.h"
+
+namespace ret3d {
+namespace eval {
+
+const char* levelKey(WaymoLevel level) { return level == WaymoLevel::L1 ? "L1" : "L2"; }
+
+double headingAccuracy(double yaw_pred, double yaw_gt) {
+  return 1.0 - std::abs(wrapAngle(yaw_pred - yaw_gt)) / M_PI;
+}
+
+double interpolatedAp(const std::vector<double>& recall, const std::vector<double>& precision) {
+  const std::size_t n = std::min(recall.size(), precision.size());
+  std::vector<double> p(precision.begin(), precision.begin() + n);
+  for (std::size_t k = n; k-- > 1;) p[k - 1] = std::max(p[k - 1], p[k]);
+  double ap = 0, prev_r = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    ap += std::max(0.0, recall[k] - prev_r) * p[k];
+    prev_r = std::max(prev_r, recall[k]);
+  }
+  return 100.0 * ap;
+}
+
+namespace {
+
+// One class in one frame: its ground truth and predictions and their 3D IoUs.
+struct ClassFrame {
+  std::vector<const Box*> gt;
+  std::vector<char> gt_ignore;
+  std::vector<const Box*> pred;  // sorted by descending score
+  std::vector<double> iou;       // pred x gt
+};
+
+struct Scored {
+  double score;
+  bool tp;
+  double heading;
+};
+
+double horizontalRange(const Box& b) { return std::hypot(b.x, b.y); }
+
+// Greedy matching of one frame under one configuration; appends every counted prediction to `out` and returns the
+// number of valid ground truth.
+int matchFrame(const ClassFrame& cf, const std::vector<char>& gt_valid, const std::vector<char>& gt_used,
+               const std::vector<char>& pred_used, double threshold, std::vector<Scored>& out) {
+  const std::size_t ng = cf.gt.size();
+  std::vector<char> taken(ng, 0);
+  int n_valid = 0;
+  for (std::size_t g = 0; g < ng; ++g) n_valid += gt_used[g] && gt_valid[g];
+  for (std::size_t p = 0; p < cf.pred.size(); ++p) {
+    if (!pred_used[p]) continue;
+    int best = -1, best_ignored = -1;
+    double best_iou = threshold, best_ignored_iou = threshold;
+    for (std::size_t g = 0; g < ng; ++g) {
+      if (!gt_used[g]) continue;
+      const double o = cf.iou[p * ng + g];
+      if (gt_valid[g]) {
+        if (!taken[g] && o >= best_iou) {
+          best_iou = o;
+          best = static_cast<int>(g);
+        }
+      } else if (o >= best_ignored_iou) {
+        best_ignored_iou = o;
+        best_ignored = static_cast<int>(g);
+      }
+    }
+    if (best >= 0) {
+      taken[best] = 1;
+      out.push_back({cf.pred[p]->score, true, headingAccuracy(cf.pred[p]->yaw, cf.gt[best]->yaw)});
+    } else if (best_ignored < 0) {
+      out.push_back({cf.pred[p]->score, false, 0.0});
+    }
+  }
+  return n_valid;
+}
+
+WaymoCurve curveFrom(std::vector<Scored> dets, int num_gt) {
+  WaymoCurve c;
+  c.num_gt = num_gt;
+  std::stable_sort(dets.begin(), dets.end(), [](const Scored& a, const Scored& b) { return a.score > b.score; });
+  double tp = 0, fp = 0, h = 0;
+  for (std::size_t i = 0; i < dets.size(); ++i) {
+    if (dets[i].tp) {
+      tp += 1;
+      h += dets[i].heading;
+    } else {
+      fp += 1;
+    }
+    // One curve point per distinct score: ties are cut together.
+    if (i + 1 < dets.size() && dets[i + 1].score == dets[i].score) continue;
+    const double n = std::max(1, num_gt);
+    c.recall.push_back(tp / n);
+    c.precision.push_back(tp / (tp + fp));
+    c.recall_h.push_back(h / n);
+    c.precision_h.push_back(h / (tp + fp));
+  }
+  c.num_tp = static_cast<int>(tp);
+  c.num_fp = static_cast<int>(fp);
+  if (num_gt > 0) {
+    c.ap = interpolatedAp(c.recall, c.precision);
+    c.aph = interpolatedAp(c.recall_h, c.precision_h);
+  }
+  return c;
+}
+
+}  // namespace
+
+WaymoResult evaluateWaymo(const std::vector<EvalFrame>& frames, const WaymoOptions& options) {
+  WaymoResult result;
+  result.used_point_counts = options.use_point_counts;
+  const std::size_t nc = options.classes.size();
+  const std::size_t nr = options.ranges.size();
+  detail::ProgressCounter progress(options.progress, nc * (1 + kWaymoNumLevels * (1 + nr)));
+  result.classes.resize(nc);
+  for (std::size_t c = 0; c < nc; ++c) {
+    WaymoClassResult& cr = result.classes[c];
+    cr.cls = options.classes[c];
+    const int ci = static_cast<int>(cr.cls) - 1;
+    if (ci < 0 || ci > 2) throw std::invalid_argument("evaluateWaymo: only Car, Pedestrian and Cyclist are evaluated");
+    cr.iou_threshold = options.iou_threshold[ci];
+
+    // Per frame: the class's boxes and their IoUs (computed once, shared by every level and range).
+    std::vector<ClassFrame> cfs(frames.size());
+    detail::parallelFor(frames.size(), options.threads, [&](std::size_t i) {
+      const EvalFrame& f = frames[i];
+      ClassFrame& cf = cfs[i];
+      for (std::size_t g = 0; g < f.gt_boxes.size(); ++g) {
+        const Box& b = f.gt_boxes[g];
+        if (b.label != cr.cls) continue;
+        const bool ignore = g < f.gt_ignore.size() && f.gt_ignore[g];
+        if (options.use_point_counts && b.num_points == 0 && !ignore) continue;  // not in the ground truth
+        cf.gt.push_back(&b);
+        cf.gt_ignore.push_back(ignore);
+      }
+      for (const Box& b : f.pred_boxes) {
+        if (b.label == cr.cls) cf.pred.push_back(&b);
+      }
+      std::stable_sort(cf.pred.begin(), cf.pred.end(), [](const Box* a, const Box* b) { return a->score > b->score; });
+      cf.iou.resize(cf.pred.size() * cf.gt.size());
+      for (std::size_t p = 0; p < cf.pred.size(); ++p) {
+        for (std::size_t g = 0; g < cf.gt.size(); ++g) cf.iou[p * cf.gt.size() + g] = iou3d(*cf.pred[p], *cf.gt[g]);
+      }
+    });
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+      for (const Box& b : frames[i].gt_boxes) {
+        if (c == 0 && options.use_point_counts && b.num_points == 0 && b.label != ObjectClass::Unknown) {
+          ++result.dropped_empty_gt;
+        }
+      }
+    }
+    progress.tick();
+
+    // Configurations: each level over all ranges, then each (range, level).
+    const std::size_t n_configs = kWaymoNumLevels * (1 + nr);
+    cr.ranges.resize(nr);
+    detail::parallelFor(n_configs, options.threads, [&](std::size_t k) {
+      const int level = static_cast<int>(k % kWaymoNumLevels);
+      const int range = static_cast<int>(k / kWaymoNumLevels) - 1;  // -1: all ranges
+      std::vector<Scored> dets;
+      int num_gt = 0;
+      std::vector<char> valid, gt_used, pred_used;
+      for (const ClassFrame& cf : cfs) {
+        valid.assign(cf.gt.size(), 1);
+        gt_used.assign(cf.gt.size(), 1);
+        pred_used.assign(cf.pred.size(), 1);
+        for (std::size_t g = 0; g < cf.gt.size(); ++g) {
+          const bool level2 =
+              options.use_point_counts && static_cast<int>(cf.gt[g]->num_points) <= options.level2_max_points;
+          const bool out_of_range =
+              range >= 0 && (horizontalRange(*cf.gt[g]) < options.ranges[range].min ||
+                             horizontalRange(*cf.gt[g]) >= options.ranges[range].max);
+          valid[g] = !cf.gt_ignore[g] && !(level == 0 && level2) && !out_of_range;
+        }
+        if (range >= 0) {
+          for (std::size_t p = 0; p < cf.pred.size(); ++p) {
+            const double r = horizontalRange(*cf.pred[p]);
+            pred_used[p] = r >= options.ranges[range].min && r < options.ranges[range].max;
+          }
+        }
+        num_gt += matchFrame(cf, valid, gt_used, pred_used, cr.iou_threshold, dets);
+      }
+      WaymoCurve curve = curveFrom(std::move(dets), num_gt);
+      if (range < 0) {
+        cr.levels[level] = std::move(curve);
+      } else {
+        cr.ranges[range][level] = std::move(curve);
+      }
+      progress.tick();
+    });
+  }
+  for (int l = 0; l < kWaymoNumLevels; ++l) {
+    int n = 0;
+    for (const auto& cr : result.classes) {
+      if (cr.levels[l].num_gt == 0) continue;
+      result.mean_ap[l] += cr.levels[l].ap;
+      result.mean_aph[l] += cr.levels[l].aph;
+      ++n;
+    }
+    if (n > 0) {
+      result.mean_ap[l] /= n;
+      result.mean_aph[l] /= n;
+    }
+  }
+  return result;
+}
+
+}  // namespace eval
+}  // namespace ret3d
