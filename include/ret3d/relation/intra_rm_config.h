@@ -1,0 +1,62 @@
+// Configuration of IntraRM (Ret3D §3.2): the network's shape (saved in every model file) and the training settings.
+// Read from YAML (config/relation/intra_rm.yaml); an unknown key or a bad value fails loudly, naming it.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+namespace ret3d {
+namespace relation {
+
+// What defines a trained network; stored in the model file and checked when it is loaded.
+struct IntraRMArch {
+  std::size_t feature_dim = 0;  // length of the detector feature o_i (eq. 1); 0 = basic features d_i alone
+  int hidden = 64;              // C_x, the node feature length
+  int rounds = 4;               // m, the message-passing rounds (eqs. (2)-(3) repeated)
+  double radius = 2.0;          // r, metres: objects closer than this (BEV centres) are linked
+  bool use_edges = true;        // false: self-loops only, each object refined alone (no-edge ablation)
+  int head_hidden = 128;        // width of the head's hidden layer
+
+  void validate() const;  // throws std::invalid_argument naming the field
+};
+
+// Per class (Car, Pedestrian, Cyclist, the order of kDetectedClasses).
+using PerClass = std::array<double, 3>;
+
+struct IntraRMTrainConfig {
+  double lr = 3e-4;             // AdamW, as the paper
+  double weight_decay = 0.01;
+  int frames_per_batch = 16;
+  int epochs = 30;
+  double loc_weight = 2.0;      // lambda_1 of eq. (5)
+  double dir_weight = 0.2;      // lambda_2 of eq. (5)
+  double focal_alpha = 0.25;
+  double focal_gamma = 2.0;
+  // A detection is a positive of its class when its class-aware BEV IoU with a ground-truth box reaches this
+  // (the KITTI 3D thresholds, so the refined score ranks boxes the benchmark counts as hits)...
+  PerClass cls_pos_iou{{0.7, 0.5, 0.5}};
+  // ...and its box is regressed towards that ground truth when the IoU reaches this.
+  PerClass reg_min_iou{{0.5, 0.3, 0.3}};
+  bool augment_flip = true;        // mirror y (and yaw) with probability 0.5
+  double augment_rotation = 0.39;  // rotate a frame about the sensor's z axis by U(-a, a) radians
+  std::uint64_t seed = 1;
+
+  void validate() const;
+};
+
+struct IntraRMConfig {
+  IntraRMArch model;
+  IntraRMTrainConfig train;
+};
+
+// Reads a YAML file with optional sections `model:` and `train:`; missing keys keep their defaults.
+IntraRMConfig loadIntraRMConfig(const std::string& path);
+// Parses YAML text (`source` names it in error messages).
+IntraRMConfig parseIntraRMConfig(const std::string& yaml_text, const std::string& source = "<string>");
+// The configuration as YAML text, which parseIntraRMConfig reads back.
+std::string toYaml(const IntraRMConfig& config);
+
+}  // namespace relation
+}  // namespace ret3d

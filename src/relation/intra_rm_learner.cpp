@@ -1,0 +1,278 @@
+// Training IntraRM: Ret3D eq. (5) and AdamW (the paper's optimiser, lr 3e-4, weight decay 0.01).
+#include "ret3d/relation/intra_rm_learner.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+
+#include <yaml-cpp/yaml.h>
+
+#include "intra_rm_network.h"
+#include "ret3d/core/geometry.h"
+
+namespace ret3d {
+namespace relation {
+
+namespace fs = std::filesystem;
+
+struct IntraRMLearner::Impl {
+  IntraRMConfig config;
+  IntraRM model;
+  std::unique_ptr<torch::optim::AdamW> optimizer;
+  std::mt19937_64 rng;
+
+  Impl(const IntraRMConfig& c, std::uint64_t seed) : config(c), model(c.model, seed), rng(seed) {
+    model.impl().info.config = c;
+    optimizer = std::make_unique<torch::optim::AdamW>(
+        model.impl().net->parameters(),
+        torch::optim::AdamWOptions(c.train.lr).weight_decay(c.train.weight_decay));
+  }
+
+  IntraRMNet& net() { return model.impl().net; }
+
+  // Loss of eq. (5) over a batch; `targets` aligned with the batch's nodes.
+  std::pair<torch::Tensor, IntraRMLoss> loss(const std::vector<const Detections*>& dets,
+                                             const std::vector<const std::vector<IntraRMTarget>*>& targets) {
+    const IntraRMInputs in = makeIntraRMInputs(dets, config.model);
+    const int64_t n = static_cast<int64_t>(in.nodes);
+    torch::Tensor cls_t = torch::zeros({n, 3}), cls_w = torch::zeros({n, 1}), reg_m = torch::zeros({n});
+    torch::Tensor loc_t = torch::zeros({n, 3}), box_t = torch::zeros({n, 4});
+    auto ct = cls_t.accessor<float, 2>();
+    auto cw = cls_w.accessor<float, 2>();
+    auto rm = reg_m.accessor<float, 1>();
+    auto lt = loc_t.accessor<float, 2>();
+    auto bt = box_t.accessor<float, 2>();
+    int64_t i = 0;
+    double positives = 0;
+    for (const auto* tv : targets) {
+      for (const IntraRMTarget& t : *tv) {
+        for (int k = 0; k < 3; ++k) ct[i][k] = t.cls[k];
+        cw[i][0] = t.cls_weight;
+        positives += (t.cls[0] + t.cls[1] + t.cls[2]) > 0 ? t.cls_weight : 0;
+        if (t.regress) {
+          rm[i] = 1;
+          lt[i][0] = t.dx, lt[i][1] = t.dy, lt[i][2] = t.dz;
+          bt[i][0] = t.dyaw, bt[i][1] = t.dl, bt[i][2] = t.dw, bt[i][3] = t.dh;
+        }
+        ++i;
+      }
+    }
+    const IntraRMOutput out = net()->forward(in.basic, in.feat, in.source, in.target);
+    // Focal loss (Lin et al.), sigmoid per class channel, normalised by the number of positives.
+    const double alpha = config.train.focal_alpha, gamma = config.train.focal_gamma;
+    const torch::Tensor p = torch::sigmoid(out.cls);
+    const torch::Tensor ce = torch::binary_cross_entropy_with_logits(out.cls, cls_t, {}, {}, at::Reduction::None);
+    const torch::Tensor p_t = p * cls_t + (1 - p) * (1 - cls_t);
+    const torch::Tensor a_t = alpha * cls_t + (1 - alpha) * (1 - cls_t);
+    const torch::Tensor l_cls = (a_t * torch::pow(1 - p_t, gamma) * ce * cls_w).sum() / std::max(1.0, positives);
+    // Smooth-L1 on location (centre and log size: the box's place and extent) and on heading, over regressed boxes.
+    const double n_reg = std::max(1.0, reg_m.sum().item<double>());
+    const torch::Tensor m = reg_m.unsqueeze(1);
+    const torch::Tensor pred_reg = torch::cat({out.loc, out.box.slice(1, 1, 4)}, 1);
+    const torch::Tensor t_reg = torch::cat({loc_t, box_t.slice(1, 1, 4)}, 1);
+    const torch::Tensor l_reg =
+        (torch::smooth_l1_loss(pred_reg, t_reg, at::Reduction::None) * m).sum() / n_reg;
+    const torch::Tensor l_dir =
+        (torch::smooth_l1_loss(out.box.slice(1, 0, 1), box_t.slice(1, 0, 1), at::Reduction::None) * m).sum() /
+        n_reg;
+    const torch::Tensor total = l_cls + config.train.loc_weight * l_reg + config.train.dir_weight * l_dir;
+    IntraRMLoss L;
+    L.total = total.item<double>();
+    L.cls = l_cls.item<double>();
+    L.reg = l_reg.item<double>();
+    L.dir = l_dir.item<double>();
+    L.positives = static_cast<std::size_t>(positives);
+    L.nodes = in.nodes;
+    return {total, L};
+  }
+};
+
+IntraRMLearner::IntraRMLearner(const IntraRMConfig& config, std::uint64_t seed)
+    : impl_(std::make_unique<Impl>(config, seed)) {
+  config.model.validate();
+  config.train.validate();
+}
+
+IntraRMLearner::~IntraRMLearner() = default;
+
+void IntraRMLearner::fitNormalisation(const std::vector<IntraRMFrame>& frames) {
+  const IntraRMArch& a = impl_->config.model;
+  std::vector<double> sum(kIntraBasicFeatures, 0), sq(kIntraBasicFeatures, 0);
+  std::vector<double> fsum(a.feature_dim, 0), fsq(a.feature_dim, 0);
+  double count = 0;
+  float f[kIntraBasicFeatures];
+  for (const IntraRMFrame& fr : frames) {
+    if (a.feature_dim > 0 && fr.detections.feature_dim != a.feature_dim)
+      throw std::invalid_argument("IntraRM training: a frame has feature_dim " +
+                                  std::to_string(fr.detections.feature_dim) + ", the model " +
+                                  std::to_string(a.feature_dim));
+    for (std::size_t i = 0; i < fr.detections.size(); ++i) {
+      basicFeatures(fr.detections.boxes[i], f);
+      for (int k = 0; k < kIntraBasicFeatures; ++k) sum[k] += f[k], sq[k] += double(f[k]) * f[k];
+      for (std::size_t k = 0; k < a.feature_dim; ++k) {
+        const double v = fr.detections.feature(i)[k];
+        fsum[k] += v, fsq[k] += v * v;
+      }
+      ++count;
+    }
+  }
+  if (count < 2) return;
+  auto stats = [&](const std::vector<double>& s, const std::vector<double>& q, torch::Tensor& mean,
+                   torch::Tensor& stdev, const std::vector<bool>& keep) {
+    for (std::size_t k = 0; k < s.size(); ++k) {
+      if (!keep.empty() && !keep[k]) continue;  // heading sin/cos and one-hot are already in [-1, 1]
+      const double mu = s[k] / count;
+      const double sd = std::sqrt(std::max(0.0, q[k] / count - mu * mu));
+      mean[static_cast<int64_t>(k)] = mu;
+      stdev[static_cast<int64_t>(k)] = sd > 1e-6 ? sd : 1.0;
+    }
+  };
+  torch::NoGradGuard no_grad;
+  auto& net = impl_->net();
+  std::vector<bool> keep(kIntraBasicFeatures, true);
+  for (int k : {6, 7, 11, 12, 13}) keep[static_cast<std::size_t>(k)] = false;
+  stats(sum, sq, net->basic_mean, net->basic_std, keep);
+  stats(fsum, fsq, net->feat_mean, net->feat_std, {});
+}
+
+IntraRMLoss IntraRMLearner::step(const std::vector<const IntraRMFrame*>& batch) {
+  const auto& tc = impl_->config.train;
+  // Augmentation: one rotation about the sensor's z axis and an optional mirror (y -> -y) per frame, applied to the
+  // boxes and to the regression targets alike (size residuals are invariant; centre residuals turn with the frame;
+  // the heading residual changes sign under the mirror).
+  std::vector<Detections> dets(batch.size());
+  std::vector<std::vector<IntraRMTarget>> targets(batch.size());
+  std::uniform_real_distribution<double> rot(-tc.augment_rotation, tc.augment_rotation);
+  std::bernoulli_distribution flip(0.5);
+  for (std::size_t f = 0; f < batch.size(); ++f) {
+    dets[f] = batch[f]->detections;
+    targets[f] = batch[f]->targets;
+    const double th = tc.augment_rotation > 0 ? rot(impl_->rng) : 0.0;
+    const bool mirror = tc.augment_flip && flip(impl_->rng);
+    const double c = std::cos(th), s = std::sin(th);
+    auto turn = [&](double& x, double& y) {
+      if (mirror) y = -y;
+      const double nx = c * x - s * y, ny = s * x + c * y;
+      x = nx, y = ny;
+    };
+    for (Box& b : dets[f].boxes) {
+      turn(b.x, b.y);
+      turn(b.vx, b.vy);
+      b.yaw = wrapAngle((mirror ? -b.yaw : b.yaw) + th);
+    }
+    for (IntraRMTarget& t : targets[f]) {
+      double dx = t.dx, dy = t.dy;
+      turn(dx, dy);
+      t.dx = static_cast<float>(dx), t.dy = static_cast<float>(dy);
+      if (mirror) t.dyaw = -t.dyaw;
+    }
+  }
+  std::vector<const Detections*> dp;
+  std::vector<const std::vector<IntraRMTarget>*> tp;
+  for (std::size_t f = 0; f < batch.size(); ++f) dp.push_back(&dets[f]), tp.push_back(&targets[f]);
+  impl_->net()->train();
+  auto [total, L] = impl_->loss(dp, tp);
+  impl_->optimizer->zero_grad();
+  total.backward();
+  torch::nn::utils::clip_grad_norm_(impl_->net()->parameters(), 10.0);
+  impl_->optimizer->step();
+  impl_->net()->eval();
+  return L;
+}
+
+IntraRMLoss IntraRMLearner::evaluate(const std::vector<IntraRMFrame>& frames) const {
+  torch::NoGradGuard no_grad;
+  IntraRMLoss sum;
+  double batches = 0;
+  const std::size_t bs = static_cast<std::size_t>(impl_->config.train.frames_per_batch);
+  for (std::size_t s = 0; s < frames.size(); s += bs) {
+    std::vector<const Detections*> dp;
+    std::vector<const std::vector<IntraRMTarget>*> tp;
+    for (std::size_t f = s; f < std::min(frames.size(), s + bs); ++f)
+      dp.push_back(&frames[f].detections), tp.push_back(&frames[f].targets);
+    const IntraRMLoss L = impl_->loss(dp, tp).second;
+    sum.total += L.total, sum.cls += L.cls, sum.reg += L.reg, sum.dir += L.dir;
+    sum.positives += L.positives, sum.nodes += L.nodes;
+    ++batches;
+  }
+  if (batches > 0) sum.total /= batches, sum.cls /= batches, sum.reg /= batches, sum.dir /= batches;
+  return sum;
+}
+
+const IntraRM& IntraRMLearner::model() const { return impl_->model; }
+
+IntraRM IntraRMLearner::snapshot() const {
+  IntraRM copy(impl_->config.model);
+  copy.impl().info = impl_->model.info();
+  torch::NoGradGuard no_grad;
+  auto dst_p = copy.impl().net->named_parameters();
+  for (const auto& p : impl_->model.impl().net->named_parameters()) dst_p[p.key()].copy_(p.value());
+  auto dst_b = copy.impl().net->named_buffers();
+  for (const auto& b : impl_->model.impl().net->named_buffers()) dst_b[b.key()].copy_(b.value());
+  return copy;
+}
+
+void IntraRMLearner::setTrainedOn(const std::string& text) { impl_->model.impl().info.trained_on = text; }
+
+void IntraRMLearner::saveCheckpoint(const std::string& dir, int epoch, double best_val) const {
+  fs::create_directories(dir);
+  impl_->model.save(dir + "/model.pt");
+  torch::save(*impl_->optimizer, dir + "/optimizer.pt");
+  YAML::Node s;
+  s["epoch"] = epoch;
+  s["best_val"] = best_val;
+  std::ostringstream rng;
+  rng << impl_->rng;
+  s["rng"] = rng.str();
+  const std::string tmp = dir + "/state.yaml.tmp";
+  {
+    std::ofstream out(tmp);
+    YAML::Emitter e;
+    e << s;
+    out << e.c_str() << "\n";
+  }
+  fs::rename(tmp, dir + "/state.yaml");
+}
+
+bool IntraRMLearner::loadCheckpoint(const std::string& dir, int* epoch, double* best_val) {
+  if (!fs::exists(dir + "/state.yaml")) return false;
+  YAML::Node s;
+  try {
+    s = YAML::LoadFile(dir + "/state.yaml");
+    *epoch = s["epoch"].as<int>();
+    *best_val = s["best_val"].as<double>();
+    std::istringstream rng(s["rng"].as<std::string>());
+    rng >> impl_->rng;
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error("IntraRM checkpoint " + dir + "/state.yaml: unreadable (" + std::string(e.what()) + ")");
+  }
+  IntraRMOptions o;
+  o.model_path = dir + "/model.pt";
+  IntraRM saved(o);
+  const IntraRMArch& a = saved.arch();
+  const IntraRMArch& b = impl_->config.model;
+  if (a.feature_dim != b.feature_dim || a.hidden != b.hidden || a.rounds != b.rounds || a.head_hidden != b.head_hidden ||
+      a.radius != b.radius || a.use_edges != b.use_edges)
+    throw std::runtime_error("IntraRM checkpoint " + dir + ": network shape differs from the configuration (" +
+                             toYaml({a, {}}) + ")");
+  torch::NoGradGuard no_grad;
+  auto dst_p = impl_->net()->named_parameters();
+  for (const auto& p : saved.impl().net->named_parameters()) dst_p[p.key()].copy_(p.value());
+  auto dst_b = impl_->net()->named_buffers();
+  for (const auto& bb : saved.impl().net->named_buffers()) dst_b[bb.key()].copy_(bb.value());
+  impl_->model.impl().info.trained_on = saved.info().trained_on;
+  try {
+    torch::load(*impl_->optimizer, dir + "/optimizer.pt");
+  } catch (const std::exception& e) {
+    std::string msg = e.what();
+    throw std::runtime_error("IntraRM checkpoint " + dir + "/optimizer.pt: unreadable (" +
+                             msg.substr(0, msg.find('\n')) + ")");
+  }
+  return true;
+}
+
+}  // namespace relation
+}  // namespace ret3d

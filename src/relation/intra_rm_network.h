@@ -1,0 +1,67 @@
+// IntraRM's torch network and the model file format; private to src/relation (and the trainer), so the public
+// headers stay free of torch.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <torch/torch.h>
+
+#include "ret3d/core/detections.h"
+#include "ret3d/relation/intra_rm.h"
+#include "ret3d/relation/radius_graph.h"
+
+namespace ret3d {
+namespace relation {
+
+inline constexpr int kIntraRMFormatVersion = 1;
+inline constexpr const char* kIntraRMFormatName = "ret3d-intra-rm";
+// Output channels: centre residual (3), heading residual (1) + log-size residual (3), class logits (3).
+inline constexpr int kIntraNumClasses = 3;
+
+struct IntraRMOutput {
+  torch::Tensor loc;  // n x 3: centre residual, metres
+  torch::Tensor box;  // n x 4: heading residual (rad), log-size residuals (l, w, h)
+  torch::Tensor cls;  // n x 3: class logits (Car, Pedestrian, Cyclist)
+};
+
+class IntraRMNetImpl : public torch::nn::Module {
+ public:
+  explicit IntraRMNetImpl(const IntraRMArch& arch);
+  // basic: n x 14 raw basic features; feat: n x feature_dim (or undefined when feature_dim 0); source/target: the
+  // graph's edges (int64). Normalises, embeds (eq. 1), runs `rounds` EdgeConv rounds (eqs. 2-3), concatenates the
+  // rounds (eq. 4) and applies the head.
+  IntraRMOutput forward(const torch::Tensor& basic, const torch::Tensor& feat, const torch::Tensor& source,
+                        const torch::Tensor& target);
+
+  IntraRMArch arch;
+  // Input normalisation (buffers, saved with the weights): x_norm = (x - mean) / std.
+  torch::Tensor basic_mean, basic_std, feat_mean, feat_std;
+  torch::nn::Linear embed{nullptr};                 // W^x of eq. (1)
+  std::vector<torch::nn::Sequential> edge_mlps;     // H of eq. (2), one per round
+  torch::nn::Sequential head_trunk{nullptr};
+  torch::nn::Linear head_loc{nullptr}, head_box{nullptr}, head_cls{nullptr};
+};
+TORCH_MODULE(IntraRMNet);
+
+struct IntraRM::Impl {
+  IntraRMModelInfo info;
+  IntraRMNet net{nullptr};
+};
+
+// The inputs of one batch of frames as tensors (frames laid side by side; edges never cross frames).
+struct IntraRMInputs {
+  torch::Tensor basic, feat, source, target;
+  std::size_t nodes = 0;
+};
+IntraRMInputs makeIntraRMInputs(const std::vector<const Detections*>& frames, const IntraRMArch& arch);
+
+// Applies the predicted residuals and scores to the input boxes.
+Detections applyIntraRMOutput(const Detections& input, const IntraRMOutput& out);
+
+// Model file: a torch archive holding the parameters and buffers plus a YAML metadata string.
+void saveIntraRMModel(const std::string& path, const IntraRM::Impl& impl);
+void loadIntraRMModel(const std::string& path, IntraRM::Impl* impl);  // throws std::runtime_error
+
+}  // namespace relation
+}  // namespace ret3d
