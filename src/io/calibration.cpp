@@ -1,7 +1,6 @@
 // KITTI calibration files, in the object key style ("P2:", "R0_rect:", "Tr_velo_to_cam:", "Tr_imu_to_velo:") and the
 // tracking devkit's style ("P2", "R_rect", "Tr_velo_cam", "Tr_imu_velo", with or without the colon).
 #include <cmath>
-#include <fstream>
 #include <map>
 
 #include "ret3d/io/kitti.h"
@@ -89,21 +88,14 @@ std::optional<Eigen::Vector2d> Calibration::projectRect(const Eigen::Vector3d& p
 }
 
 Calibration readCalibration(const std::string& path) {
-  std::ifstream in = detail::openForRead(path);
   std::map<Key, std::vector<double>> values;
   std::map<Key, int> seen_at;
-  std::string line;
-  int line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    const auto fields = detail::splitFields(line);
-    if (fields.empty()) continue;
+  detail::forEachLine(path, [&](const auto& fields, const detail::Where& where) {
     std::string_view name = fields[0];
     if (!name.empty() && name.back() == ':') name.remove_suffix(1);
     const auto it = keyTable().find(name);
-    if (it == keyTable().end()) continue;
+    if (it == keyTable().end()) return;
     const KeyInfo& info = it->second;
-    const detail::Where where{path, line_no};
     if (const auto prev = seen_at.find(info.key); prev != seen_at.end()) {
       detail::fail(where, name, "given twice (first at line " + std::to_string(prev->second) + ")");
     }
@@ -119,8 +111,8 @@ Calibration readCalibration(const std::string& path) {
       v[i] = detail::parseDouble(fields[i + 1], where, field);
     }
     values[info.key] = std::move(v);
-    seen_at[info.key] = line_no;
-  }
+    seen_at[info.key] = where.line;
+  });
 
   const auto require = [&](Key k, const char* name, const char* alias) -> const std::vector<double>& {
     const auto it = values.find(k);
@@ -155,9 +147,7 @@ void writeCalibration(const std::string& path, const Calibration& calib) {
   appendValues(s, "R0_rect", r0.data(), 9);
   appendMatrix34(s, "Tr_velo_to_cam", calib.velo_to_cam.matrix().topRows<3>());
   appendMatrix34(s, "Tr_imu_to_velo", calib.imu_to_velo.matrix().topRows<3>());
-  std::ofstream out = detail::openForWrite(path);
-  out << s;
-  detail::closeWritten(out, path);
+  detail::writeText(path, s);
 }
 
 Calibration defaultCalibration() {

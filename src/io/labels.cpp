@@ -1,7 +1,6 @@
 // KITTI label files: object layout (label_2, 15 fields + optional score) and tracking layout (label_02, frame and
 // track id first, truncation an integer, 17 fields + optional score).
 #include <cmath>
-#include <fstream>
 
 #include "ret3d/io/kitti.h"
 #include "text_fields.h"
@@ -62,16 +61,10 @@ Label parseLine(const std::vector<std::string_view>& f, const detail::Where& whe
 }
 
 std::vector<Label> readLabels(const std::string& path, bool tracking) {
-  std::ifstream in = detail::openForRead(path);
   std::vector<Label> labels;
-  std::string line;
-  int line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    const auto fields = detail::splitFields(line);
-    if (fields.empty()) continue;
-    labels.push_back(parseLine(fields, {path, line_no}, tracking));
-  }
+  detail::forEachLine(path, [&](const auto& fields, const detail::Where& where) {
+    labels.push_back(parseLine(fields, where, tracking));
+  });
   return labels;
 }
 
@@ -106,11 +99,12 @@ void appendCommon(std::string& s, const Label& l, bool tracking) {
 }
 
 void writeLines(const std::string& path, const std::vector<Label>& labels, bool tracking) {
-  std::ofstream out = detail::openForWrite(path);
+  std::string s;
   for (const Label& l : labels) {
-    out << (tracking ? formatTrackingLabel(l) : formatObjectLabel(l)) << '\n';
+    s += tracking ? formatTrackingLabel(l) : formatObjectLabel(l);
+    s += '\n';
   }
-  detail::closeWritten(out, path);
+  detail::writeText(path, s);
 }
 
 }  // namespace

@@ -1,7 +1,7 @@
 // KITTI OXTS (GPS/IMU) records, 30 values per line, and their conversion to LiDAR poses as the KITTI raw devkit does
 // (convertOxtsToPose.m).
+#include <algorithm>
 #include <cmath>
-#include <fstream>
 
 #include "ret3d/io/kitti.h"
 #include "rigid.h"
@@ -21,27 +21,13 @@ constexpr double kEarthRadius = 6378137.0;  // WGS84 equatorial radius, as the d
 }  // namespace
 
 std::vector<OxtsRecord> readOxts(const std::string& path) {
-  std::ifstream in = detail::openForRead(path);
   std::vector<OxtsRecord> records;
-  std::string line;
-  int line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    const auto f = detail::splitFields(line);
-    if (f.empty()) continue;
-    const detail::Where where{path, line_no};
-    if (f.size() < 30) {
-      detail::fail(where, kOxtsFields[f.size()],
-                   "missing; the line has " + std::to_string(f.size()) + " values (an OXTS record has 30)");
-    }
-    if (f.size() > 30) {
-      detail::fail(where, kOxtsFields[29],
-                   "followed by " + std::to_string(f.size() - 30) + " extra value(s) (an OXTS record has 30)");
-    }
+  detail::forEachLine(path, [&](const auto& fields, const detail::Where& where) {
+    const auto v = detail::parseNumberRow(fields, where, kOxtsFields, 30, "an OXTS record");
     OxtsRecord r;
-    for (int i = 0; i < 30; ++i) r.values[i] = detail::parseDouble(f[i], where, kOxtsFields[i]);
+    std::copy(v.begin(), v.end(), r.values.begin());
     records.push_back(r);
-  }
+  });
   return records;
 }
 
@@ -54,9 +40,7 @@ void writeOxts(const std::string& path, const std::vector<OxtsRecord>& records) 
     }
     s += '\n';
   }
-  std::ofstream out = detail::openForWrite(path);
-  out << s;
-  detail::closeWritten(out, path);
+  detail::writeText(path, s);
 }
 
 std::vector<Eigen::Isometry3d> oxtsToLidarPoses(const std::vector<OxtsRecord>& records, const Calibration& calib) {

@@ -1,7 +1,5 @@
 // Ego poses in the KITTI odometry convention (pose/SSSS.txt: one row-major 3x4 camera-to-world matrix per frame),
 // and their conversion to LiDAR poses.
-#include <fstream>
-
 #include "ret3d/io/kitti.h"
 #include "rigid.h"
 #include "text_fields.h"
@@ -16,27 +14,13 @@ constexpr const char* kPoseFields[12] = {"r11", "r12", "r13", "tx", "r21", "r22"
 }  // namespace
 
 std::vector<Eigen::Isometry3d> readPoses(const std::string& path) {
-  std::ifstream in = detail::openForRead(path);
   std::vector<Eigen::Isometry3d> poses;
-  std::string line;
-  int line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    const auto f = detail::splitFields(line);
-    if (f.empty()) continue;
-    const detail::Where where{path, line_no};
-    if (f.size() < 12) {
-      detail::fail(where, kPoseFields[f.size()],
-                   "missing; the line has " + std::to_string(f.size()) + " numbers (a 3x4 pose has 12)");
-    }
-    if (f.size() > 12) {
-      detail::fail(where, kPoseFields[11],
-                   "followed by " + std::to_string(f.size() - 12) + " extra number(s) (a 3x4 pose has 12)");
-    }
+  detail::forEachLine(path, [&](const auto& fields, const detail::Where& where) {
+    const auto v = detail::parseNumberRow(fields, where, kPoseFields, 12, "a 3x4 pose");
     Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
-    for (int i = 0; i < 12; ++i) t.matrix()(i / 4, i % 4) = detail::parseDouble(f[i], where, kPoseFields[i]);
+    for (int i = 0; i < 12; ++i) t.matrix()(i / 4, i % 4) = v[i];
     poses.push_back(t);
-  }
+  });
   return poses;
 }
 
@@ -49,9 +33,7 @@ void writePoses(const std::string& path, const std::vector<Eigen::Isometry3d>& p
     }
     s += '\n';
   }
-  std::ofstream out = detail::openForWrite(path);
-  out << s;
-  detail::closeWritten(out, path);
+  detail::writeText(path, s);
 }
 
 std::vector<Eigen::Isometry3d> cameraPosesToLidar(const std::vector<Eigen::Isometry3d>& cam_poses,

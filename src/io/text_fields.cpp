@@ -58,6 +58,40 @@ int parseInt(std::string_view token, const Where& where, std::string_view field)
   return static_cast<int>(std::lround(v));
 }
 
+void forEachLine(const std::string& path,
+                 const std::function<void(const std::vector<std::string_view>&, const Where&)>& fn) {
+  std::ifstream in = openForRead(path);
+  std::string line;
+  int line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    const auto fields = splitFields(line);
+    if (!fields.empty()) fn(fields, Where{path, line_no});
+  }
+}
+
+std::vector<double> parseNumberRow(const std::vector<std::string_view>& fields, const Where& where,
+                                   const char* const* names, int count, const std::string& what) {
+  const int n = static_cast<int>(fields.size());
+  if (n < count) {
+    fail(where, names[n], "missing; the line has " + std::to_string(n) + " values (" + what + " has " +
+                              std::to_string(count) + ")");
+  }
+  if (n > count) {
+    fail(where, names[count - 1], "followed by " + std::to_string(n - count) + " extra value(s) (" + what + " has " +
+                                      std::to_string(count) + ")");
+  }
+  std::vector<double> v(count);
+  for (int i = 0; i < count; ++i) v[i] = parseDouble(fields[i], where, names[i]);
+  return v;
+}
+
+void writeText(const std::string& path, const std::string& text) {
+  std::ofstream out = openForWrite(path);
+  out << text;
+  closeWritten(out, path);
+}
+
 std::ifstream openForRead(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error("cannot open '" + path + "' for reading: " + std::strerror(errno));

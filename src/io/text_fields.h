@@ -3,6 +3,7 @@
 #pragma once
 
 #include <fstream>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -28,6 +29,16 @@ std::vector<std::string_view> splitFields(std::string_view line);
 double parseDouble(std::string_view token, const Where& where, std::string_view field);
 // An integer (written either as "3" or as an integral float such as "3.00"); ParseError otherwise.
 int parseInt(std::string_view token, const Where& where, std::string_view field);
+
+// Calls fn(fields, where) for every non-blank line of a text file.
+void forEachLine(const std::string& path,
+                 const std::function<void(const std::vector<std::string_view>&, const Where&)>& fn);
+// A line of exactly `count` numbers named names[0..count-1] (a pose row, an OXTS record); `what` names the record in
+// the field-count message, e.g. "a 3x4 pose".
+std::vector<double> parseNumberRow(const std::vector<std::string_view>& fields, const Where& where,
+                                   const char* const* names, int count, const std::string& what);
+// Replaces the file's content with `text`.
+void writeText(const std::string& path, const std::string& text);
 
 // Opens a file for reading / writing; std::runtime_error naming the file when that fails.
 std::ifstream openForRead(const std::string& path);
