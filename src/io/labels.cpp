@@ -1,6 +1,7 @@
 // KITTI label files: object layout (label_2, 15 fields + optional score) and tracking layout (label_02, frame and
 // track id first, truncation an integer, 17 fields + optional score).
 #include <cmath>
+#include <stdexcept>
 
 #include "ret3d/io/kitti.h"
 #include "text_fields.h"
@@ -119,6 +120,8 @@ std::string formatObjectLabel(const Label& l) {
 }
 
 std::string formatTrackingLabel(const Label& l) {
+  // boxToLabel leaves frame at -1: writing that would give a file no reader (ours included) accepts.
+  if (l.frame < 0) throw std::invalid_argument("tracking label without a frame index (frame = -1): set Label::frame");
   std::string s = std::to_string(l.frame) + ' ' + std::to_string(l.track_id) + ' ';
   appendCommon(s, l, true);
   return s;

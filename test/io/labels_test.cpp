@@ -163,6 +163,8 @@ TEST(Labels, TrackingWriteReadRoundTripWritesIntegerTruncation) {
   EXPECT_EQ(back[0].frame, 12);
   EXPECT_EQ(back[0].track_id, 3);
   EXPECT_EQ(back[1].track_id, -1);
+  a.frame = -1;  // e.g. straight from boxToLabel
+  EXPECT_THROW(kitti::formatTrackingLabel(a), std::invalid_argument);
 }
 
 TEST(Labels, MalformedLinesNameFileLineAndField) {

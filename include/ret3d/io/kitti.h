@@ -36,6 +36,7 @@ void writeVelodyne(const std::string& path, const PointCloud& cloud);
 //   type truncated occluded alpha x1 y1 x2 y2 h w l x y z rotation_y [score]
 // Tracking layout (label_02): frame track_id, then the same fields (truncated an integer level there).
 // Writers use fixed notation with 6 decimals, which the KITTI devkits read; score is written only when present.
+// The tracking writers throw std::invalid_argument for a label whose frame is negative (not set).
 struct Label {
   int frame = -1;            // tracking layout only
   int track_id = -1;         // tracking layout only (-1 for DontCare)
