@@ -37,7 +37,41 @@ void GreedyTracker::reset() { tracks_.clear(); }
 
 std::vector<Box> GreedyTracker::update(const std::vector<Box>& detections, double stamp,
                                        const Eigen::Isometry3d& sensor_to_fixed) {
+  std::vector<Box> out;
+  step(detections, nullptr, 0, stamp, sensor_to_fixed, out);
+  return out;
+}
+
+Detections GreedyTracker::update(const Detections& detections, double stamp,
+                                 const Eigen::Isometry3d& sensor_to_fixed) {
+  detections.validate();
+  Detections out;
+  const std::vector<std::size_t> rows =
+      step(detections.boxes, detections.hasFeatures() ? detections.features.data() : nullptr, detections.feature_dim,
+            stamp, sensor_to_fixed, out.boxes);
+  out.feature_dim = detections.feature_dim;
+  out.features.reserve(rows.size() * out.feature_dim);
+  for (std::size_t r : rows)
+    out.features.insert(out.features.end(), detections.feature(r), detections.feature(r) + out.feature_dim);
+  return out;
+}
+
+std::vector<std::size_t> GreedyTracker::step(const std::vector<Box>& detections, const float* features,
+                                             std::size_t feature_dim, double stamp,
+                                             const Eigen::Isometry3d& sensor_to_fixed, std::vector<Box>& out) {
   if (!std::isfinite(stamp)) throw std::invalid_argument("GreedyTracker::update: stamp is not finite");
+  if (!features) feature_dim = 0;
+  if (!detections.empty() && feature_dim != feature_dim_) {  // an empty frame says nothing about its producer
+    // Histories hold one feature size: a new producer (another detector, a stage switched off) starts afresh.
+    if (!tracks_.empty()) {
+      RET3D_WARN("tracker reset: detection features changed from " << feature_dim_ << " to " << feature_dim
+                                                                    << " values; dropped " << tracks_.size()
+                                                                    << " tracks");
+      reset();
+      ++num_resets_;
+    }
+    feature_dim_ = feature_dim;
+  }
 
   // Time since the previous frame; a jump backwards (bag loop) or a long gap makes the tracks meaningless.
   double dt = 0.0;
@@ -124,7 +158,7 @@ std::vector<Box> GreedyTracker::update(const std::vector<Box>& detections, doubl
       track->last_seen = stamp;
       track->misses = 0;
       fixed.track_id = track->id;
-      track->history.push(fixed, stamp);
+      track->history.push(fixed, stamp, features ? features + c.index * feature_dim : nullptr, feature_dim);
 
       Box out = detections[c.index];
       out.track_id = track->id;
@@ -152,11 +186,14 @@ std::vector<Box> GreedyTracker::update(const std::vector<Box>& detections, doubl
   tracks_.erase(tracks_.begin() + static_cast<std::ptrdiff_t>(kept), tracks_.end());
   for (Track& b : born) tracks_.push_back(std::move(b));
 
-  std::vector<Box> out;
-  out.reserve(detections.size());
-  for (std::size_t i = 0; i < detections.size(); ++i)
-    if (emitted[i]) out.push_back(out_by_index[i]);
-  return out;
+  out.clear();
+  std::vector<std::size_t> rows;
+  for (std::size_t i = 0; i < detections.size(); ++i) {
+    if (!emitted[i]) continue;
+    out.push_back(out_by_index[i]);
+    rows.push_back(i);
+  }
+  return rows;
 }
 
 void GreedyTracker::matchClass(ObjectClass label, const std::vector<Candidate>& dets, double dt, double now,

@@ -481,12 +481,61 @@ TEST(GreedyTracker, EstimatedVelocityIsTheLeastSquaresSlope) {
   EXPECT_NEAR(last.vy, -3.0, 1e-9);
 }
 
+TEST(GreedyTracker, DetectionFeaturesFollowTheirBoxesIntoOutputAndHistory) {
+  GreedyTracker tracker{TrackerOptions()};
+  const Actor a{ObjectClass::Car, 10, 0, 10, 0}, b{ObjectClass::Pedestrian, 5, 5, 1, 0};
+  std::uint32_t id_b = 0;
+  for (int f = 0; f < 3; ++f) {
+    Detections d;
+    d.feature_dim = 2;
+    Box low = a.at(f * kDt);
+    low.y += 20;
+    low.score = 0.05f;  // below score_threshold: not output, its feature row must not be either
+    d.boxes = {a.at(f * kDt), low, b.at(f * kDt)};
+    d.features = {1.0f + f, 2.0f, 99, 99, 3.0f + f, 4.0f};
+    const Detections out = tracker.update(d, f * kDt, Eigen::Isometry3d::Identity());
+    ASSERT_EQ(out.size(), 2u);
+    ASSERT_EQ(out.feature_dim, 2u);
+    ASSERT_EQ(out.features.size(), 4u);
+    EXPECT_EQ(out.boxes[0].label, ObjectClass::Car);
+    EXPECT_FLOAT_EQ(out.feature(0)[0], 1.0f + f);
+    EXPECT_FLOAT_EQ(out.feature(1)[0], 3.0f + f);
+    id_b = out.boxes[1].track_id;
+  }
+  const TrackHistory* h = tracker.findHistory(id_b);
+  ASSERT_NE(h, nullptr);
+  ASSERT_EQ(h->size(), 3u);
+  ASSERT_EQ(h->featureDim(), 2u);
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_FLOAT_EQ(h->feature(i)[0], 3.0f + i);
+
+  // Another producer's feature size: a reset with one log line, then tracking goes on.
+  LogCapture log;
+  Detections d;
+  d.feature_dim = 3;
+  d.boxes = {a.at(0.3)};
+  d.features = {1, 2, 3};
+  const Detections out = tracker.update(d, 0.3, Eigen::Isometry3d::Identity());
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_GT(out.boxes[0].track_id, id_b);
+  EXPECT_EQ(tracker.numResets(), 1u);
+  EXPECT_EQ(log.lines.size(), 1u);
+  // An empty frame without features is no change of producer.
+  EXPECT_TRUE(tracker.update(Detections(), 0.4, Eigen::Isometry3d::Identity()).empty());
+  EXPECT_EQ(tracker.numTracks(), 1u);
+  d.boxes = {a.at(0.5)};
+  EXPECT_EQ(tracker.update(d, 0.5, Eigen::Isometry3d::Identity()).boxes[0].track_id, out.boxes[0].track_id);
+  EXPECT_EQ(tracker.numResets(), 1u);
+  Detections bad = d;
+  bad.features.pop_back();
+  EXPECT_THROW(tracker.update(bad, 0.6, Eigen::Isometry3d::Identity()), std::invalid_argument);
+}
+
 TEST(GreedyTracker, RejectsInvalidOptionsAndStamps) {
   TrackerOptions o;
   o.max_age = -2;
   EXPECT_THROW(GreedyTracker{o}, std::invalid_argument);
   GreedyTracker tracker{TrackerOptions()};
-  EXPECT_THROW(tracker.update({}, std::nan(""), Eigen::Isometry3d::Identity()), std::invalid_argument);
+  EXPECT_THROW(tracker.update(std::vector<Box>(), std::nan(""), Eigen::Isometry3d::Identity()), std::invalid_argument);
 }
 
 // Time per update() for 50 tracks with the default history length (median of 300 frames after the histories are

@@ -76,5 +76,26 @@ TEST(TrackHistory, MovedIntoSensorFrameByHand) {
   EXPECT_DOUBLE_EQ(s[1].box.length, 4.0);  // sizes unchanged
 }
 
+TEST(TrackHistory, FeaturesTravelWithTheirBoxes) {
+  TrackHistory h(2);
+  EXPECT_EQ(h.feature(0), nullptr);
+  for (int i = 0; i < 3; ++i) {
+    const float f[3] = {float(i), float(10 * i), float(100 * i)};
+    h.push(boxAt(i, 0), i, f, 3);
+  }
+  ASSERT_EQ(h.featureDim(), 3u);
+  ASSERT_EQ(h.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_FLOAT_EQ(h.feature(i)[0], h[i].box.x);
+    EXPECT_FLOAT_EQ(h.feature(i)[2], 100 * h[i].box.x);
+  }
+  const float g[2] = {1, 2};
+  EXPECT_THROW(h.push(boxAt(0, 0), 4, g, 2), std::invalid_argument);
+  h.clear();
+  h.push(boxAt(0, 0), 5, g, 2);  // a cleared history takes a new feature size
+  EXPECT_EQ(h.featureDim(), 2u);
+  EXPECT_FLOAT_EQ(h.feature(0)[1], 2.0f);
+}
+
 }  // namespace
 }  // namespace ret3d

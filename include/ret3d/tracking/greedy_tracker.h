@@ -13,6 +13,7 @@
 
 #include <Eigen/Geometry>
 
+#include "ret3d/core/detections.h"
 #include "ret3d/core/types.h"
 #include "ret3d/tracking/track_history.h"
 #include "ret3d/tracking/tracker_options.h"
@@ -32,6 +33,9 @@ class GreedyTracker {
   // A stamp before the previous one (a bag loop) or more than max_time_gap after it resets the tracker first, with
   // one log line; track ids keep counting, so they are never reused within the tracker's life.
   std::vector<Box> update(const std::vector<Box>& detections, double stamp, const Eigen::Isometry3d& sensor_to_fixed);
+  // The same for a stage's Detections: each output box keeps its feature row, and the features are kept in the
+  // tracks' histories beside the boxes (TrackHistory::feature). A change of feature_dim resets the tracker (logged).
+  Detections update(const Detections& detections, double stamp, const Eigen::Isometry3d& sensor_to_fixed);
 
   // Forgets all tracks (ids keep counting).
   void reset();
@@ -64,6 +68,10 @@ class GreedyTracker {
   };
   struct Candidate;  // a detection prepared for matching (fixed frame)
 
+  // Both update()s: features is boxes.size() x feature_dim or null; returns the detection index of each output box.
+  std::vector<std::size_t> step(const std::vector<Box>& boxes, const float* features, std::size_t feature_dim,
+                                double stamp, const Eigen::Isometry3d& sensor_to_fixed, std::vector<Box>& out);
+
   void matchClass(ObjectClass label, const std::vector<Candidate>& dets, double dt, double now,
                   std::vector<int>& det_to_track);
   // Least-squares velocity over the last velocity_window centres of the history plus `current`; false if too few.
@@ -77,6 +85,7 @@ class GreedyTracker {
   double last_stamp_ = 0.0;
   Eigen::Isometry3d last_sensor_to_fixed_ = Eigen::Isometry3d::Identity();
   std::size_t num_resets_ = 0;
+  std::size_t feature_dim_ = 0;  // of the features in the tracks' histories
   bool warned_unknown_class_ = false;
 };
 

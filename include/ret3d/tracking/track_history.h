@@ -26,8 +26,10 @@ class TrackHistory {
  public:
   explicit TrackHistory(std::size_t capacity);
 
-  // Appends; when full, the oldest entry is overwritten.
-  void push(const Box& box_fixed, double stamp);
+  // Appends; when full, the oldest entry is overwritten. `feature` (feature_dim floats, e.g. the detector's feature
+  // of the box) is kept beside the box when given. The first push after construction or clear() fixes featureDim();
+  // a later push with another feature_dim throws std::invalid_argument.
+  void push(const Box& box_fixed, double stamp, const float* feature = nullptr, std::size_t feature_dim = 0);
   void clear();
 
   std::size_t size() const { return size_; }
@@ -36,6 +38,11 @@ class TrackHistory {
   // i = 0 is the oldest entry kept, size() - 1 the newest.
   const HistoryEntry& operator[](std::size_t i) const { return buffer_[(head_ + i) % buffer_.size()]; }
   const HistoryEntry& newest() const { return (*this)[size_ - 1]; }
+  // Feature of entry i (featureDim() floats), nullptr when the history has no features.
+  std::size_t featureDim() const { return feature_dim_; }
+  const float* feature(std::size_t i) const {
+    return feature_dim_ ? features_.data() + ((head_ + i) % buffer_.size()) * feature_dim_ : nullptr;
+  }
 
   // All entries, oldest first, moved into the sensor frame whose pose in the fixed frame is sensor_to_fixed, with
   // time offsets relative to `now` (Ret3D §3.3: "the location features from past time-stamps have been projected to
@@ -44,6 +51,8 @@ class TrackHistory {
 
  private:
   std::vector<HistoryEntry> buffer_;
+  std::vector<float> features_;  // capacity() x feature_dim_, slot-aligned with buffer_
+  std::size_t feature_dim_ = 0;
   std::size_t head_ = 0;  // index of the oldest entry
   std::size_t size_ = 0;
 };
