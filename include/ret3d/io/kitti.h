@@ -86,7 +86,8 @@ Calibration readCalibration(const std::string& path);
 // and the key. Tr_imu_to_velo (Tr_imu_velo) is optional (identity); P0, P1, P3 are optional (zero when absent).
 // Writes the object key style, which readCalibration reads back.
 void writeCalibration(const std::string& path, const Calibration& calib);
-// A KITTI-like calibration (the values of the tracking benchmark's sequence 0000), used by the simulator.
+// A KITTI-like calibration, used by the simulator: the real values of the tracking benchmark's sequences 0000-0013
+// (one calibration, recorded 2011-09-26; identical to ../shared/data's calib/0001.txt).
 Calibration defaultCalibration();
 
 // ---- label <-> box ----
