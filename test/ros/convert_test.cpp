@@ -17,6 +17,7 @@
 #include "ret3d/io/kitti.h"
 #include "ret3d/ros/conversions.h"
 #include "ret3d/ros/kitti_bag.h"
+#include "ros/tiny_sequence.h"
 #include "test_util.h"
 
 namespace fs = std::filesystem;
@@ -43,109 +44,6 @@ CommandResult run(const std::string& command) {
 
 std::string cli() { return std::string(RET3D_CLI); }
 
-Box makeBox(ObjectClass c, double x, double y, double z, double l, double w, double h, double yaw) {
-  Box b;
-  b.label = c;
-  b.x = x;
-  b.y = y;
-  b.z = z;
-  b.length = l;
-  b.width = w;
-  b.height = h;
-  b.yaw = yaw;
-  return b;
-}
-
-// k^3 points strictly inside the box (a lattice at 10 % .. 90 % of each dimension).
-void addLatticeInside(const Box& b, int k, float intensity, PointCloud& cloud) {
-  const double c = std::cos(b.yaw), s = std::sin(b.yaw);
-  for (int i = 0; i < k; ++i) {
-    for (int j = 0; j < k; ++j) {
-      for (int m = 0; m < k; ++m) {
-        const double u = (0.1 + 0.8 * i / (k - 1) - 0.5) * b.length;
-        const double v = (0.1 + 0.8 * j / (k - 1) - 0.5) * b.width;
-        const double w = (0.1 + 0.8 * m / (k - 1) - 0.5) * b.height;
-        cloud.points.push_back({static_cast<float>(b.x + c * u - s * v), static_cast<float>(b.y + s * u + c * v),
-                                static_cast<float>(b.z + w), intensity});
-      }
-    }
-  }
-}
-
-// A tiny KITTI tracking sequence: a car driving ahead (+0.5 m per frame) and a standing pedestrian, each filled with
-// a lattice of points, on a ground grid 1.73 m below the sensor; a Van and a DontCare region in the labels (to be
-// skipped); the ego vehicle moving 1 m per frame along the camera's z (forward).
-struct TinySequence {
-  static constexpr int kFrames = 4;
-  static constexpr int kCarPoints = 125;        // 5^3
-  static constexpr int kPedestrianPoints = 64;  // 4^3
-  kitti::Calibration calib = kitti::defaultCalibration();
-  std::vector<std::vector<Box>> boxes;  // per frame: car, pedestrian (LiDAR frame, track ids 1 and 2)
-  std::vector<PointCloud> scans;
-  std::vector<Eigen::Isometry3d> camera_poses;
-
-  void write(const std::string& root, const std::string& seq, int frames, bool with_labels) {
-    const fs::path training = fs::path(root) / "training";
-    fs::create_directories(training / "velodyne" / seq);
-    fs::create_directories(training / "calib");
-    fs::create_directories(training / "pose");
-    fs::create_directories(training / "label_02");
-    kitti::writeCalibration((training / "calib" / (seq + ".txt")).string(), calib);
-    std::vector<kitti::Label> labels;
-    boxes.clear();
-    scans.clear();
-    camera_poses.clear();
-    for (int f = 0; f < frames; ++f) {
-      Box car = makeBox(ObjectClass::Car, 10.0 + 0.5 * f, 2.0, -0.9, 4.0, 1.8, 1.5, 0.3);
-      car.track_id = 1;
-      Box ped = makeBox(ObjectClass::Pedestrian, 6.0, -3.0, -0.85, 0.8, 0.6, 1.7, -1.2);
-      ped.track_id = 2;
-      Box van = makeBox(ObjectClass::Unknown, 20.0, -6.0, -0.7, 5.0, 2.0, 2.0, 0.0);
-      boxes.push_back({car, ped});
-
-      PointCloud scan;
-      for (double x = 2.0; x <= 30.0; x += 0.5) {
-        for (double y = -10.0; y <= 10.0; y += 0.5) {
-          scan.points.push_back({static_cast<float>(x), static_cast<float>(y), -1.73f, 0.2f});
-        }
-      }
-      addLatticeInside(car, 5, 0.9f, scan);
-      addLatticeInside(ped, 4, 0.5f, scan);
-      addLatticeInside(van, 3, 0.7f, scan);
-      char name[16];
-      std::snprintf(name, sizeof(name), "%06d.bin", f);
-      kitti::writeVelodyne((training / "velodyne" / seq / name).string(), scan);
-      scans.push_back(scan);
-
-      for (const Box& b : {car, ped}) {
-        kitti::Label l = kitti::boxToLabel(b, calib);
-        l.frame = f;
-        labels.push_back(l);
-      }
-      kitti::Label van_label = kitti::boxToLabel(van, calib);
-      van_label.type = "Van";
-      van_label.frame = f;
-      van_label.track_id = 2;
-      labels.push_back(van_label);
-      kitti::Label dont_care;
-      dont_care.type = "DontCare";
-      dont_care.frame = f;
-      dont_care.track_id = -1;
-      dont_care.bbox = {{100, 150, 200, 200}};
-      dont_care.h = dont_care.w = dont_care.l = -1;
-      dont_care.x = dont_care.y = dont_care.z = -1000;
-      dont_care.rotation_y = -10;
-      labels.push_back(dont_care);
-
-      Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-      pose.translation() = Eigen::Vector3d(0.0, 0.0, 1.0 * f);  // camera z is forward
-      camera_poses.push_back(pose);
-    }
-    if (with_labels) kitti::writeTrackingLabels((training / "label_02" / (seq + ".txt")).string(), labels);
-    kitti::writePoses((training / "pose" / (seq + ".txt")).string(), camera_poses);
-  }
-};
-
 template <typename T>
 std::vector<std::pair<ros::Time, boost::shared_ptr<T>>> readTopic(const std::string& bag_path,
                                                                   const std::string& topic) {
@@ -162,8 +60,8 @@ std::vector<std::pair<ros::Time, boost::shared_ptr<T>>> readTopic(const std::str
 
 TEST(ConvertCommand, TinyTrackingSequenceToBagAndBack) {
   test::TempDir tmp;
-  TinySequence seq;
-  seq.write(tmp.path(), "0000", TinySequence::kFrames, /*with_labels=*/true);
+  test::TinySequence seq;
+  seq.write(tmp.path(), "0000", test::TinySequence::kFrames, /*with_labels=*/true);
   const std::string bag_path = tmp / "tiny.bag";
 
   const CommandResult conv = run(cli() + " convert " + tmp.path() + " " + bag_path + " --rate 5");
@@ -196,8 +94,8 @@ TEST(ConvertCommand, TinyTrackingSequenceToBagAndBack) {
   // /tf: odom -> base_link follows the camera poses moved into the LiDAR frame (about 1 m forward per frame).
   const auto lidar_poses = kitti::cameraPosesToLidar(seq.camera_poses, seq.calib);
   const auto tfs = readTopic<tf2_msgs::TFMessage>(bag_path, "/tf");
-  ASSERT_EQ(tfs.size(), static_cast<std::size_t>(TinySequence::kFrames));
-  for (int f = 0; f < TinySequence::kFrames; ++f) {
+  ASSERT_EQ(tfs.size(), static_cast<std::size_t>(test::TinySequence::kFrames));
+  for (int f = 0; f < test::TinySequence::kFrames; ++f) {
     ASSERT_EQ(tfs[f].second->transforms.size(), 1u);
     const auto& t = tfs[f].second->transforms[0];
     EXPECT_EQ(t.header.frame_id, "odom");
@@ -213,8 +111,8 @@ TEST(ConvertCommand, TinyTrackingSequenceToBagAndBack) {
 
   // /points: every scan, in order, stamped by frame index / rate, in the velodyne frame, same points.
   const auto clouds = readTopic<sensor_msgs::PointCloud2>(bag_path, "/points");
-  ASSERT_EQ(clouds.size(), static_cast<std::size_t>(TinySequence::kFrames));
-  for (int f = 0; f < TinySequence::kFrames; ++f) {
+  ASSERT_EQ(clouds.size(), static_cast<std::size_t>(test::TinySequence::kFrames));
+  for (int f = 0; f < test::TinySequence::kFrames; ++f) {
     const auto& msg = *clouds[f].second;
     EXPECT_EQ(msg.header.frame_id, "velodyne");
     EXPECT_NEAR(msg.header.stamp.toSec(), kStart + f / kRate, 1e-6);
@@ -233,14 +131,14 @@ TEST(ConvertCommand, TinyTrackingSequenceToBagAndBack) {
   // /ground_truth/objects: the car and the pedestrian (Van and DontCare skipped), LiDAR-frame boxes with track ids
   // (KITTI id + 1) and the number of points inside, stamped like the clouds.
   const auto gts = readTopic<ret3d::Object3DArray>(bag_path, "/ground_truth/objects");
-  ASSERT_EQ(gts.size(), static_cast<std::size_t>(TinySequence::kFrames));
-  for (int f = 0; f < TinySequence::kFrames; ++f) {
+  ASSERT_EQ(gts.size(), static_cast<std::size_t>(test::TinySequence::kFrames));
+  for (int f = 0; f < test::TinySequence::kFrames; ++f) {
     const auto& msg = *gts[f].second;
     EXPECT_EQ(msg.header.frame_id, "velodyne");
     EXPECT_EQ(msg.header.stamp, clouds[f].second->header.stamp);
     const std::vector<Box> got = fromMsg(msg);
     ASSERT_EQ(got.size(), 2u) << "frame " << f;
-    const std::uint32_t expected_points[2] = {TinySequence::kCarPoints, TinySequence::kPedestrianPoints};
+    const std::uint32_t expected_points[2] = {test::TinySequence::kCarPoints, test::TinySequence::kPedestrianPoints};
     for (std::size_t k = 0; k < 2; ++k) {
       const Box& want = seq.boxes[f][k];
       EXPECT_EQ(got[k].label, want.label);
@@ -259,7 +157,7 @@ TEST(ConvertCommand, TinyTrackingSequenceToBagAndBack) {
 
 TEST(ConvertCommand, SequenceOptionPicksTheSequenceAndUnlabelledHasNoGroundTruth) {
   test::TempDir tmp;
-  TinySequence labelled, unlabelled;
+  test::TinySequence labelled, unlabelled;
   labelled.write(tmp.path(), "0000", 4, /*with_labels=*/true);
   unlabelled.write(tmp.path(), "0007", 3, /*with_labels=*/false);
   const std::string bag_path = tmp / "seq7.bag";
@@ -285,7 +183,7 @@ TEST(ConvertCommand, BadInputGivesAClearErrorAndExitCode) {
   EXPECT_NE(none.output.find("no scans"), std::string::npos) << none.output;
 
   // Labels without a calibration cannot become LiDAR boxes.
-  TinySequence seq;
+  test::TinySequence seq;
   seq.write(tmp / "nocalib", "0000", 2, true);
   fs::remove(tmp / "nocalib/training/calib/0000.txt");
   const CommandResult nocalib = run(cli() + " convert " + (tmp / "nocalib") + " " + (tmp / "x.bag"));
