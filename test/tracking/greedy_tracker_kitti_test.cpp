@@ -173,19 +173,11 @@ TEST(GreedyTrackerKitti, AblationOverTrainingSequences) {
   };
   with("gates 1.0/0.6/0.8", [](TrackerOptions& o) { o.gate = {1.0, 0.6, 0.8}; });
   with("gates 1.2/0.5/0.8", [](TrackerOptions& o) { o.gate = {1.2, 0.5, 0.8}; });
-  with("max_age 5, hungarian", [](TrackerOptions& o) {
-    o.max_age = 5;
-    o.assignment = AssignmentMethod::Hungarian;
-  });
-  with("max_age 5, birth_score 0.9", [](TrackerOptions& o) {
-    o.max_age = 5;
-    o.birth_score = 0.9;
-  });
   with("gates 0.8/0.4/0.6 (CenterPoint Waymo)", [](TrackerOptions& o) { o.gate = {0.8, 0.4, 0.6}; });
   with("gates 1.5/0.6/1.0", [](TrackerOptions& o) { o.gate = {1.5, 0.6, 1.0}; });
   with("gates 2.0/1.0/1.5", [](TrackerOptions& o) { o.gate = {2.0, 1.0, 1.5}; });
   with("max_age 1", [](TrackerOptions& o) { o.max_age = 1; });
-  with("max_age 5", [](TrackerOptions& o) { o.max_age = 5; });
+  with("max_age 3", [](TrackerOptions& o) { o.max_age = 3; });
   with("max_age 10", [](TrackerOptions& o) { o.max_age = 10; });
   with("hungarian", [](TrackerOptions& o) { o.assignment = AssignmentMethod::Hungarian; });
   with("velocity_window 3", [](TrackerOptions& o) { o.velocity_window = 3; });

@@ -37,7 +37,8 @@ struct TrackerOptions {
   // cyclist 0.6; nuScenes (2 Hz keyframes, "99.9 percentile of the l2 velocity error per 0.5 s") car 4, pedestrian 1,
   // bicycle 3, i.e. 0.8 / 0.2 / 0.6 when scaled to 0.1 s. Our frames are 10 Hz like Waymo's, so Waymo's values, but
   // 1.0 m for cars: with velocities estimated from noisy boxes (KITTI PointRCNN, 0001-0015) car ID switches were
-  // 147 / 122 / 208 for 0.8 / 1.0 / 1.5 m; pedestrians and cyclists hardly changed between 0.4-1.0 and 0.6-1.5 m.
+  // 135 / 105 / 90 / 190 for 0.8 / 1.0 / 1.2 / 1.5 m; 1.0 keeps a margin from that cliff. Pedestrians and cyclists
+  // hardly changed between 0.4-1.0 and 0.6-1.5 m.
   PerClass<double> gate{1.0, 0.4, 0.6};
   // Fastest plausible speed (m/s). A track whose velocity is not known yet (one observation, detections without
   // velocity) gets gate + max_speed * (time since it was last seen), since it may have moved that far.
@@ -65,6 +66,7 @@ struct TrackerOptions {
 
   // Boxes kept per track for InterRM (ring buffer). The paper's sequences average 100 frames on Waymo; at 10 Hz 30
   // entries are 3 s of motion, which bounds InterRM's O(N^2) attention for 50 tracks within the real-time budget.
+  // To be revisited by InterRM's ablation over N (the tracker's cost hardly depends on it).
   int history_length = 30;
 };
 
