@@ -1,0 +1,211 @@
+// Training InterRM: the smooth-L1 loss L_inter of Ret3D §3.3 on the current box's residuals, AdamW (lr 3e-4, weight
+// decay 0.01, 64 sequences per batch: the paper's settings).
+#include "ret3d/relation/inter_rm_learner.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+
+#include <yaml-cpp/yaml.h>
+
+#include "inter_rm_network.h"
+#include "ret3d/core/geometry.h"
+
+namespace ret3d {
+namespace relation {
+
+namespace fs = std::filesystem;
+
+std::array<float, 7> interResiduals(const Box& c, const Box& t) {
+  const double cs = std::cos(c.yaw), sn = std::sin(c.yaw);
+  const double dx = t.x - c.x, dy = t.y - c.y;
+  // The KITTI IoU ignores the direction: the heading residual is taken modulo pi, within [-pi/2, pi/2).
+  double dyaw = wrapAngle(t.yaw - c.yaw);
+  if (dyaw >= M_PI / 2) dyaw -= M_PI;
+  if (dyaw < -M_PI / 2) dyaw += M_PI;
+  return {{static_cast<float>(cs * dx + sn * dy), static_cast<float>(-sn * dx + cs * dy),
+           static_cast<float>(t.z - c.z), static_cast<float>(std::log(t.length / c.length)),
+           static_cast<float>(std::log(t.width / c.width)), static_cast<float>(std::log(t.height / c.height)),
+           static_cast<float>(dyaw)}};
+}
+
+struct InterRMLearner::Impl {
+  InterRMConfig config;
+  InterRM model;
+  std::unique_ptr<torch::optim::AdamW> optimizer;
+  std::mt19937_64 rng;
+
+  Impl(const InterRMConfig& c, std::uint64_t seed) : config(c), model(c.model, seed), rng(seed) {
+    model.impl().info.config = c;
+    optimizer = std::make_unique<torch::optim::AdamW>(
+        model.impl().net->parameters(), torch::optim::AdamWOptions(c.train.lr).weight_decay(c.train.weight_decay));
+  }
+  InterRMNet& net() { return model.impl().net; }
+
+  std::pair<torch::Tensor, InterRMLoss> loss(const std::vector<const InterRMSample*>& batch) {
+    std::vector<const InterRMSequence*> seqs;
+    torch::Tensor target = torch::zeros({static_cast<int64_t>(batch.size()), kInterOutputs});
+    auto acc = target.accessor<float, 2>();
+    for (std::size_t i = 0; i < batch.size(); ++i) {
+      seqs.push_back(&batch[i]->sequence);
+      const auto r = interResiduals(batch[i]->sequence.boxes.at(0), batch[i]->target);
+      for (int k = 0; k < kInterOutputs; ++k) acc[static_cast<int64_t>(i)][k] = r[static_cast<std::size_t>(k)];
+    }
+    const torch::Tensor pred = net()->forward(makeInterRMInputs(seqs, config.model.max_history));
+    const torch::Tensor l = torch::smooth_l1_loss(pred, target, at::Reduction::None, config.train.smooth_l1_beta);
+    const torch::Tensor per = l.sum(1);  // per sequence: all seven residuals
+    const torch::Tensor total = per.mean();
+    InterRMLoss L;
+    L.total = total.item<double>();
+    L.loc = l.slice(1, 0, 3).sum(1).mean().item<double>();
+    L.size = l.slice(1, 3, 6).sum(1).mean().item<double>();
+    L.yaw = l.slice(1, 6, 7).sum(1).mean().item<double>();
+    L.sequences = batch.size();
+    return {total, L};
+  }
+};
+
+InterRMLearner::InterRMLearner(const InterRMConfig& config, std::uint64_t seed)
+    : impl_(std::make_unique<Impl>(config, seed)) {
+  config.model.validate();
+  config.train.validate();
+}
+
+InterRMLearner::~InterRMLearner() = default;
+
+void InterRMLearner::fitNormalisation(const std::vector<InterRMSample>& samples) {
+  std::vector<double> sum(kInterBasicFeatures, 0), sq(kInterBasicFeatures, 0);
+  double count = 0;
+  float f[kInterBasicFeatures];
+  const std::size_t max_h = static_cast<std::size_t>(impl_->config.model.max_history);
+  for (const InterRMSample& s : samples) {
+    for (std::size_t k = 0; k < std::min(max_h, s.sequence.boxes.size()); ++k) {
+      interBasicFeatures(s.sequence, k, f);
+      for (int j = 0; j < kInterBasicFeatures; ++j) sum[j] += f[j], sq[j] += double(f[j]) * f[j];
+      ++count;
+    }
+  }
+  if (count < 2) return;
+  torch::NoGradGuard no_grad;
+  auto& net = impl_->net();
+  for (int j = 0; j < kInterBasicFeatures; ++j) {
+    if (j == 6 || j == 7 || (j >= 11 && j <= 13)) continue;  // heading sin/cos and one-hot are already in [-1, 1]
+    const double mu = sum[j] / count;
+    const double sd = std::sqrt(std::max(0.0, sq[j] / count - mu * mu));
+    net->feat_mean[j] = mu;
+    net->feat_std[j] = sd > 1e-6 ? sd : 1.0;
+  }
+}
+
+InterRMLoss InterRMLearner::step(const std::vector<const InterRMSample*>& batch) {
+  // Augmentation: mirror the whole scene (y -> -y) with probability 0.5; features and residuals follow.
+  std::vector<InterRMSample> copies;
+  copies.reserve(batch.size());
+  std::bernoulli_distribution flip(0.5);
+  auto mirror = [](Box& b) {
+    b.y = -b.y;
+    b.vy = -b.vy;
+    b.yaw = wrapAngle(-b.yaw);
+  };
+  for (const InterRMSample* s : batch) {
+    copies.push_back(*s);
+    if (impl_->config.train.augment_flip && flip(impl_->rng)) {
+      for (Box& b : copies.back().sequence.boxes) mirror(b);
+      mirror(copies.back().target);
+    }
+  }
+  std::vector<const InterRMSample*> ptrs;
+  for (const auto& c : copies) ptrs.push_back(&c);
+  impl_->net()->train();
+  auto [total, L] = impl_->loss(ptrs);
+  impl_->optimizer->zero_grad();
+  total.backward();
+  torch::nn::utils::clip_grad_norm_(impl_->net()->parameters(), 10.0);
+  impl_->optimizer->step();
+  impl_->net()->eval();
+  return L;
+}
+
+InterRMLoss InterRMLearner::evaluate(const std::vector<InterRMSample>& samples) const {
+  torch::NoGradGuard no_grad;
+  InterRMLoss sum;
+  const std::size_t bs = 256;
+  for (std::size_t s = 0; s < samples.size(); s += bs) {
+    std::vector<const InterRMSample*> batch;
+    for (std::size_t i = s; i < std::min(samples.size(), s + bs); ++i) batch.push_back(&samples[i]);
+    const InterRMLoss L = impl_->loss(batch).second;
+    const double n = static_cast<double>(batch.size());
+    sum.total += L.total * n, sum.loc += L.loc * n, sum.size += L.size * n, sum.yaw += L.yaw * n;
+    sum.sequences += batch.size();
+  }
+  if (sum.sequences > 0) {
+    const double n = static_cast<double>(sum.sequences);
+    sum.total /= n, sum.loc /= n, sum.size /= n, sum.yaw /= n;
+  }
+  return sum;
+}
+
+const InterRM& InterRMLearner::model() const { return impl_->model; }
+
+void InterRMLearner::setTrainedOn(const std::string& text) { impl_->model.impl().info.trained_on = text; }
+
+void InterRMLearner::saveCheckpoint(const std::string& dir, int epoch, double best_val) const {
+  fs::create_directories(dir);
+  impl_->model.save(dir + "/model.pt");
+  torch::save(*impl_->optimizer, dir + "/optimizer.pt");
+  YAML::Node s;
+  s["epoch"] = epoch;
+  s["best_val"] = best_val;
+  std::ostringstream rng;
+  rng << impl_->rng;
+  s["rng"] = rng.str();
+  const std::string tmp = dir + "/state.yaml.tmp";
+  {
+    std::ofstream out(tmp);
+    YAML::Emitter e;
+    e << s;
+    out << e.c_str() << "\n";
+  }
+  fs::rename(tmp, dir + "/state.yaml");
+}
+
+bool InterRMLearner::loadCheckpoint(const std::string& dir, int* epoch, double* best_val) {
+  if (!fs::exists(dir + "/state.yaml")) return false;
+  try {
+    const YAML::Node s = YAML::LoadFile(dir + "/state.yaml");
+    *epoch = s["epoch"].as<int>();
+    *best_val = s["best_val"].as<double>();
+    std::istringstream rng(s["rng"].as<std::string>());
+    rng >> impl_->rng;
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error("InterRM checkpoint " + dir + "/state.yaml: unreadable (" + std::string(e.what()) + ")");
+  }
+  InterRMOptions o;
+  o.model_path = dir + "/model.pt";
+  InterRM saved(o);
+  const InterRMArch& a = saved.arch();
+  const InterRMArch& b = impl_->config.model;
+  if (a.c_enc != b.c_enc || a.heads != b.heads || a.ffn_expansion != b.ffn_expansion ||
+      a.positional_encoding != b.positional_encoding || a.max_history != b.max_history)
+    throw std::runtime_error("InterRM checkpoint " + dir + ": its network differs from the configuration (" +
+                             toYaml({a, {}}) + ")");
+  torch::NoGradGuard no_grad;
+  auto dst_p = impl_->net()->named_parameters();
+  for (const auto& p : saved.impl().net->named_parameters()) dst_p[p.key()].copy_(p.value());
+  auto dst_b = impl_->net()->named_buffers();
+  for (const auto& bb : saved.impl().net->named_buffers()) dst_b[bb.key()].copy_(bb.value());
+  try {
+    torch::load(*impl_->optimizer, dir + "/optimizer.pt");
+  } catch (const std::exception& e) {
+    std::string msg = e.what();
+    throw std::runtime_error("InterRM checkpoint " + dir + "/optimizer.pt: unreadable (" +
+                             msg.substr(0, msg.find('\n')) + ")");
+  }
+  return true;
+}
+
+}  // namespace relation
+}  // namespace ret3d
