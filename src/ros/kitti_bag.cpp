@@ -173,6 +173,10 @@ ConversionPlan makePlan(const std::string& dataset_dir, const ConvertOptions& op
     }
   }
   if (plan.frames.empty()) {
+    if (hasEntries(dir / "label_02", false, ".txt") || hasEntries(dir / "label_2", false, ".txt")) {
+      throw std::runtime_error("no scans in '" + dataset_dir +
+                               "': it has labels but no velodyne/ point clouds, and a bag needs clouds");
+    }
     throw std::runtime_error("no scans in '" + dataset_dir +
                              "': expected [training/]velodyne/SSSS/NNNNNN.bin (tracking), [training/]velodyne/"
                              "NNNNNN.bin (object) or NNNNNN.bin files");
@@ -259,7 +263,7 @@ std::size_t convertKittiToBag(const std::string& dataset_dir, const std::string&
     const ros::Time stamp = start + ros::Duration(fp.index / opt.rate);
     const PointCloud cloud = kitti::readVelodyne(fp.scan_path);
 
-    // fixed_frame = base_link at the first scan: T_fixed_base = S * P_t * S^-1 (see kitti_bag.h).
+    // fixed_frame = base_link at frame 0: T_fixed_base = S * P_t * S^-1 (see kitti_bag.h).
     const Eigen::Isometry3d fixed_to_base = base_to_sensor * fp.lidar_pose * base_to_sensor.inverse();
     tf2_msgs::TFMessage tf;
     tf.transforms.push_back(toTransformMsg(fixed_to_base, opt.fixed_frame, opt.base_frame, stamp));

@@ -101,12 +101,20 @@ TEST(ConvertCommand, TinyTrackingSequenceToBagAndBack) {
     EXPECT_EQ(t.header.frame_id, "odom");
     EXPECT_EQ(t.child_frame_id, "base_link");
     EXPECT_NEAR(t.header.stamp.toSec(), kStart + f / kRate, 1e-6);
-    // A pure translation P: S * P * S^-1 has P's translation.
-    EXPECT_NEAR(t.transform.translation.x, lidar_poses[f].translation().x(), 1e-6);
-    EXPECT_NEAR(t.transform.translation.y, lidar_poses[f].translation().y(), 1e-6);
-    EXPECT_NEAR(t.transform.translation.z, lidar_poses[f].translation().z(), 1e-6);
+    // odom = base_link at frame 0: T_odom_base = S * P * S^-1, S = base_link -> velodyne (1.73 m up).
+    const Eigen::Isometry3d S(Eigen::Translation3d(0, 0, 1.73));
+    const Eigen::Isometry3d want = S * lidar_poses[f] * S.inverse();
+    EXPECT_NEAR(t.transform.translation.x, want.translation().x(), 1e-6);
+    EXPECT_NEAR(t.transform.translation.y, want.translation().y(), 1e-6);
+    EXPECT_NEAR(t.transform.translation.z, want.translation().z(), 1e-6);
+    const Eigen::Quaterniond q(t.transform.rotation.w, t.transform.rotation.x, t.transform.rotation.y,
+                               t.transform.rotation.z);
+    EXPECT_NEAR(q.angularDistance(Eigen::Quaterniond(want.linear())), 0.0, 1e-6);
+    // Independent of the calibration's details: about 1 m forward per frame, turning left 0.05 rad per frame,
+    // staying on the ground.
     EXPECT_NEAR(t.transform.translation.x, 1.0 * f, 0.05 * f + 1e-9);
-    EXPECT_NEAR(t.transform.rotation.w, 1.0, 1e-6);
+    EXPECT_NEAR(std::abs(t.transform.translation.z), 0.0, 0.05);
+    EXPECT_NEAR(2.0 * std::atan2(q.z(), q.w()), 0.05 * f, 0.01);
   }
 
   // /points: every scan, in order, stamped by frame index / rate, in the velodyne frame, same points.

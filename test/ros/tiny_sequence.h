@@ -32,7 +32,7 @@ inline void addLatticeInside(const Box& b, int k, float intensity, PointCloud& c
 
 // A tiny KITTI tracking sequence: a car driving ahead (+0.5 m per frame) and a standing pedestrian, each filled with
 // a lattice of points, on a ground grid 1.73 m below the sensor; a Van and a DontCare region in the labels (to be
-// skipped); the ego vehicle moving 1 m per frame along the camera's z (forward).
+// skipped); the ego vehicle moving 1 m per frame along the camera's z (forward) and turning 0.05 rad per frame.
 struct TinySequence {
   static constexpr int kFrames = 4;
   static constexpr int kCarPoints = 125;        // 5^3
@@ -97,7 +97,9 @@ struct TinySequence {
       dont_care.rotation_y = -10;
       labels.push_back(dont_care);
 
+      // Turning left while driving: the camera's y axis points down, so a left turn is a negative rotation about it.
       Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+      pose.linear() = Eigen::AngleAxisd(-0.05 * f, Eigen::Vector3d::UnitY()).toRotationMatrix();
       pose.translation() = Eigen::Vector3d(0.0, 0.0, 1.0 * f);  // camera z is forward
       camera_poses.push_back(pose);
     }

@@ -7,8 +7,8 @@
 //   /ground_truth/objects ret3d/Object3DArray in `sensor_frame`, when the data has labels (an empty array for a
 //                         labelled frame without objects)
 // and once, at the start, latched: /tf_static base_frame -> sensor_frame (z = sensor_height).
-// Frames: `fixed_frame` coincides with `base_frame` at the first scan, so the LiDAR pose P_t (T_velo0_velo_t) becomes
-// T_fixed_base_t = S * P_t * S^-1, with S the static base -> sensor transform.
+// Frames: `fixed_frame` coincides with `base_frame` at the sequence's first pose (frame 0), so the LiDAR pose P_t
+// (T_velo0_velo_t) becomes T_fixed_base_t = S * P_t * S^-1, with S the static base -> sensor transform.
 #pragma once
 
 #include <cstddef>
