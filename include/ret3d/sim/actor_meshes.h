@@ -1,0 +1,36 @@
+// Triangle meshes of the actors: cars of four body types, an articulated walking pedestrian and a cyclist (bike plus
+// pedalling rider). Each mesh is in the actor's frame: origin on the ground below the box centre, x forward, z up;
+// it stays inside the box (length x width x height) the labeller would draw around it, with `kLabelMargin` to spare
+// on every side so range noise does not push returns out of the box.
+#pragma once
+
+#include <string>
+
+#include "ret3d/sim/mesh.h"
+
+namespace ret3d {
+namespace sim {
+
+// Gap between a mesh and its label box on each side (m): about two range-noise sigmas.
+inline constexpr double kLabelMargin = 0.05;
+
+enum class CarBody { Sedan = 0, Hatchback = 1, Suv = 2, Van = 3 };
+const char* bodyName(CarBody b);
+
+struct ActorSurfaces {
+  Surface paint, glass, tire, plate, skin, clothing, clothing2, metal;
+};
+
+// A car whose mesh fills the box length x width x height (minus the margin): body, glazed cabin, wheels, plates.
+TriangleMesh carMesh(CarBody body, double length, double width, double height, const ActorSurfaces& s);
+
+// Body proportions of a person `stature` tall with shoulder breadth `breadth`, walking at gait phase `phase`
+// (radians; one period is two steps) with hip swing `swing` (radians, 0 = standing). Origin between the feet.
+TriangleMesh pedestrianMesh(double stature, double breadth, double phase, double swing, const ActorSurfaces& s);
+
+// A bicycle `length` long with a rider of `stature`, crank at angle `crank` (radians). Origin on the ground at the
+// middle of the wheelbase.
+TriangleMesh cyclistMesh(double length, double stature, double crank, const ActorSurfaces& s);
+
+}  // namespace sim
+}  // namespace ret3d

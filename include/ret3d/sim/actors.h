@@ -1,0 +1,107 @@
+// Actors and their motion: the ego vehicle, moving and parked cars, walking, standing and crossing pedestrians, and
+// cyclists. Vehicles and cyclists follow lanes with an intelligent-driver model (IDM: Treiber et al. 2000), obey the
+// traffic lights of intersections, change their target speed now and then, stop, and turn right; pedestrians walk
+// along sidewalks and across the road. Every move is checked against every other actor's box and the ego's, so
+// actors never interpenetrate (an actor that would overlap stays where it is for that step).
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <unordered_map>
+#include <vector>
+
+#include "ret3d/core/types.h"
+#include "ret3d/sim/actor_meshes.h"
+#include "ret3d/sim/path.h"
+#include "ret3d/sim/random.h"
+#include "ret3d/sim/scene.h"
+#include "ret3d/sim/sim_config.h"
+
+namespace ret3d {
+namespace sim {
+
+enum class ActorKind { Car, Pedestrian, Cyclist, Obstacle };  // Obstacle: a replayed Van/Truck, drawn, not labelled
+
+struct Actor {
+  std::uint32_t track_id = 0;   // 1-based and unique in the sequence; the KITTI track id is track_id - 1
+  ActorKind kind = ActorKind::Car;
+  CarBody body = CarBody::Sedan;
+  bool labelled = true;
+  // Label box size and where its centre sits in the actor frame (x forward; the mesh origin is on the ground).
+  double length = 4, width = 1.7, height = 1.5;
+  Eigen::Vector2d box_offset = Eigen::Vector2d::Zero();
+  double stature = 1.75, breadth = 0.45, swing_max = 0.4;  // pedestrians and riders
+  double phase = 0;             // gait or crank angle
+  ActorSurfaces surfaces;
+
+  // Motion along a path.
+  std::shared_ptr<const Path> path;
+  double s = 0, v = 0, v_cruise = 0, v_target = 0, next_change = 0, stop_until = -1;
+  bool moving = true;           // parked cars and standing pedestrians do not move
+  bool active = true;           // in the scene (false once it leaves its path's end, or absent in a replay frame)
+  struct Stop {
+    double s;                   // stop line station on the path
+    int intersection;
+    bool main_approach;
+  };
+  std::vector<Stop> stops;
+
+  // Pose in the world: ground point below the mesh origin, heading, velocity over ground.
+  double x = 0, y = 0, z = 0, yaw = 0, vx = 0, vy = 0;
+
+  // Replay: the world box at each frame (nullopt when not labelled in that frame).
+  std::vector<std::optional<Box>> replay;
+
+  TriangleMesh mesh;            // in the actor frame, current articulation
+  bool articulated() const { return kind == ActorKind::Pedestrian || kind == ActorKind::Cyclist; }
+  ObjectClass objectClass() const;
+};
+
+// The label box of an actor in the world frame (with velocity, class, track id).
+Box worldBox(const Actor& a);
+// The actor frame in the world: ground point below the mesh origin, heading about z.
+Eigen::Isometry3d actorPose(const Actor& a);
+// The actor's mesh for its current phase (cars: the fixed body).
+TriangleMesh actorMesh(const Actor& a);
+// A car body type and label size drawn from the config's mix, around KITTI's Car distribution.
+void drawCar(Actor& a, const SimConfig& config, Rng& rng);
+
+class Traffic {
+ public:
+  Traffic(const SimConfig& config, const Scene& scene);
+
+  // Places the ego and draws every other actor (generated scenes).
+  void spawn(Rng& rng, double view_range);
+  // Adds replayed actors (their world boxes per frame) and the ego path (world poses of the ego ground point).
+  void setReplay(std::vector<Actor> actors, std::vector<Eigen::Isometry3d> ego_poses);
+  // Advances to time t (seconds from the start) by dt; in replay, jumps to `frame`.
+  void step(double t, double dt, int frame, Rng& rng);
+
+  Actor ego;
+  std::vector<Actor> actors;
+  bool replaying() const { return replay_; }
+  // The ego's ground pose (x forward, z up) in the world at the current step.
+  Eigen::Isometry3d egoPose() const;
+
+ private:
+  void place(Actor& a);  // pose from path and station
+  void advance(Actor& a, double t, double dt, Rng& rng);
+  double leaderGap(const Actor& a, double horizon, double* leader_speed) const;
+  bool overlapsAny(const Actor& a, const Box& b) const;
+  void findStops(Actor& a) const;
+  bool green(int intersection, bool main_approach, double t) const;
+  // Actors near a point (grid of actor positions at the start of each sub-step; -1 is the ego).
+  void buildGrid();
+  std::vector<int> near(double x, double y, double radius) const;
+  std::unordered_map<long long, std::vector<int>> grid_;
+  static constexpr double kCell = 10.0;
+  std::uint32_t next_id_ = 1;
+  const SimConfig& config_;
+  const Scene& scene_;
+  bool replay_ = false;
+  std::vector<Eigen::Isometry3d> ego_poses_;
+  Eigen::Isometry3d ego_pose_ = Eigen::Isometry3d::Identity();
+};
+
+}  // namespace sim
+}  // namespace ret3d
