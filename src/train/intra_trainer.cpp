@@ -1,0 +1,189 @@
+#include "ret3d/train/intra_trainer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <numeric>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+
+#include "ret3d/core/log.h"
+#include "ret3d/core/progress.h"
+#include "ret3d/io/detections.h"
+#include "ret3d/io/kitti.h"
+
+namespace ret3d {
+namespace train {
+
+using relation::IntraRMFrame;
+
+namespace {
+
+// The KITTI devkit ignores an unmatched detection whose image box lies more than half inside a DontCare region.
+bool inDontCare(const kitti::Label& det, const std::vector<kitti::Label>& dont_care) {
+  const double w = det.bbox[2] - det.bbox[0], h = det.bbox[3] - det.bbox[1];
+  if (w <= 0 || h <= 0) return false;
+  for (const kitti::Label& d : dont_care) {
+    const double iw = std::min(det.bbox[2], d.bbox[2]) - std::max(det.bbox[0], d.bbox[0]);
+    const double ih = std::min(det.bbox[3], d.bbox[3]) - std::max(det.bbox[1], d.bbox[1]);
+    if (iw > 0 && ih > 0 && iw * ih / (w * h) > 0.5) return true;
+  }
+  return false;
+}
+
+IntraRMFrame makeFrame(const std::vector<kitti::Label>& dets, const std::vector<kitti::Label>& gt_labels,
+                       const kitti::Calibration& calib, const relation::IntraRMTrainConfig& config) {
+  relation::FrameGroundTruth gt;
+  std::vector<kitti::Label> dont_care;
+  for (const kitti::Label& l : gt_labels) {
+    if (l.type == "DontCare") {
+      dont_care.push_back(l);
+    } else if (classFromName(l.type)) {
+      gt.boxes.push_back(kitti::labelToBox(l, calib));
+    } else if (l.type == "Van" || l.type == "Person_sitting" || l.type == "Person") {
+      Box b = kitti::labelToBox(l, calib);
+      b.label = l.type == "Van" ? ObjectClass::Car : ObjectClass::Pedestrian;
+      gt.similar.push_back(b);
+    }
+  }
+  IntraRMFrame f;
+  std::vector<bool> ignore;
+  for (const kitti::Label& d : dets) {
+    if (!classFromName(d.type)) continue;
+    f.detections.boxes.push_back(kitti::labelToBox(d, calib));
+    ignore.push_back(inDontCare(d, dont_care));
+  }
+  f.targets = relation::assignIntraRMTargets(f.detections.boxes, gt, config, ignore);
+  return f;
+}
+
+}  // namespace
+
+std::vector<IntraRMFrame> loadIntraFrames(const IntraDataOptions& data, const relation::IntraRMTrainConfig& config) {
+  namespace fs = std::filesystem;
+  std::vector<IntraRMFrame> frames;
+  const io::DetectionLayout layout = io::detectDetectionLayout(data.detections_dir);
+  const std::string root = data.data_dir;
+  const bool tracking = fs::is_directory(root + "/training/label_02") || fs::is_directory(root + "/label_02");
+  if (tracking) {
+    if (layout == io::DetectionLayout::KittiObject)
+      throw std::runtime_error("detections " + data.detections_dir +
+                               " are per-frame object result files, but " + root + " is a tracking dataset");
+    kitti::TrackingDataset ds(root);
+    std::vector<std::string> seqs = data.sequences;
+    if (seqs.empty()) {
+      for (const std::string& s : ds.sequences())
+        if (ds.hasLabels(s)) seqs.push_back(s);
+    }
+    for (const std::string& seq : seqs) {
+      if (!ds.hasLabels(seq)) throw std::runtime_error("sequence " + seq + ": no labels in " + ds.dir());
+      const kitti::Calibration calib = kitti::readCalibration(ds.calibPath(seq));
+      std::map<int, std::vector<kitti::Label>> gt;
+      for (kitti::Label& l : kitti::readTrackingLabels(ds.labelPath(seq))) gt[l.frame].push_back(std::move(l));
+      const auto dets = io::readSequenceDetections(data.detections_dir, layout, seq);
+      for (const auto& [frame, labels] : dets) {
+        auto it = gt.find(frame);
+        IntraRMFrame f = makeFrame(labels, it == gt.end() ? std::vector<kitti::Label>{} : it->second, calib, config);
+        if (!f.detections.empty()) frames.push_back(std::move(f));
+      }
+    }
+  } else {
+    if (layout != io::DetectionLayout::KittiObject)
+      throw std::runtime_error("detections " + data.detections_dir + " are " + io::layoutName(layout) +
+                               " files, but " + root + " is an object dataset (label_2): use per-frame result files");
+    kitti::ObjectDataset ds(root);
+    for (const std::string& fr : ds.frames()) {
+      if (!fs::exists(ds.labelPath(fr))) continue;
+      const auto dets = io::readFrameDetections(data.detections_dir, fr);
+      IntraRMFrame f = makeFrame(dets, kitti::readObjectLabels(ds.labelPath(fr)),
+                                 kitti::readCalibration(ds.calibPath(fr)), config);
+      if (!f.detections.empty()) frames.push_back(std::move(f));
+    }
+  }
+  return frames;
+}
+
+IntraTrainReport trainIntraRM(const std::vector<IntraRMFrame>& train, const std::vector<IntraRMFrame>& val,
+                              const IntraTrainOptions& options) {
+  namespace fs = std::filesystem;
+  if (train.empty()) throw std::runtime_error("IntraRM training: no training frames with detections");
+  if (options.out_path.empty()) throw std::runtime_error("IntraRM training: no output model path");
+  const relation::IntraRMConfig& cfg = options.config;
+  const std::string ckpt = options.checkpoint_dir.empty() ? options.out_path + ".ckpt" : options.checkpoint_dir;
+  IntraTrainReport report;
+  report.train_frames = train.size();
+  report.val_frames = val.size();
+  for (const auto& f : train) report.train_boxes += f.detections.size();
+
+  relation::IntraRMLearner learner(cfg, cfg.train.seed);
+  learner.setTrainedOn(options.trained_on);
+  int start_epoch = 0;
+  double best_val = std::numeric_limits<double>::infinity();
+  if (options.resume && learner.loadCheckpoint(ckpt, &start_epoch, &best_val)) {
+    RET3D_INFO("IntraRM: resuming from " << ckpt << " after epoch " << start_epoch);
+    learner.setTrainedOn(options.trained_on);
+  } else {
+    learner.fitNormalisation(train);
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::size_t bs = static_cast<std::size_t>(cfg.train.frames_per_batch);
+  const std::size_t batches = (train.size() + bs - 1) / bs;
+  for (int epoch = start_epoch; epoch < cfg.train.epochs; ++epoch) {
+    // The shuffle depends only on the seed and the epoch, so a resumed run sees the same order.
+    std::vector<std::size_t> order(train.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::mt19937_64 rng(cfg.train.seed * 1000003ULL + static_cast<std::uint64_t>(epoch));
+    std::shuffle(order.begin(), order.end(), rng);
+    double sum = 0;
+    std::unique_ptr<ProgressBar> bar;
+    if (options.progress)
+      bar = std::make_unique<ProgressBar>("IntraRM epoch " + std::to_string(epoch + 1) + "/" +
+                                              std::to_string(cfg.train.epochs),
+                                          batches);
+    for (std::size_t b = 0; b < batches; ++b) {
+      std::vector<const IntraRMFrame*> batch;
+      for (std::size_t k = b * bs; k < std::min(train.size(), (b + 1) * bs); ++k) batch.push_back(&train[order[k]]);
+      const relation::IntraRMLoss L = learner.step(batch);
+      if (epoch == start_epoch && b == 0) report.first_train_loss = L.total;
+      sum += L.total;
+      if (bar) {
+        std::ostringstream info;
+        info.precision(4);
+        info << "loss " << L.total << " (cls " << L.cls << " reg " << L.reg << " dir " << L.dir << ")";
+        bar->tick(1, info.str());
+      }
+    }
+    if (bar) bar->finish();
+    report.last_train_loss = sum / static_cast<double>(batches);
+    std::ostringstream msg;
+    msg << "IntraRM epoch " << epoch + 1 << ": train loss " << report.last_train_loss;
+    if (!val.empty()) {
+      const relation::IntraRMLoss V = learner.evaluate(val);
+      report.val_losses.push_back(V.total);
+      msg << ", validation loss " << V.total << " (cls " << V.cls << " reg " << V.reg << " dir " << V.dir << ")";
+      if (V.total < best_val) {
+        best_val = V.total;
+        report.best_epoch = epoch + 1;
+        learner.model().save(options.out_path);
+        msg << " - best, saved";
+      }
+    }
+    RET3D_INFO(msg.str());
+    learner.saveCheckpoint(ckpt, epoch + 1, best_val);
+    report.epochs_run = epoch + 1;
+  }
+  if (val.empty()) {
+    learner.model().save(options.out_path);
+    report.best_epoch = report.epochs_run;
+  }
+  report.best_val_loss = best_val;
+  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return report;
+}
+
+}  // namespace train
+}  // namespace ret3d
