@@ -8,8 +8,10 @@
 #include <stdexcept>
 #include <strings.h>
 
+#include "ret3d/core/geometry.h"
 #include "ret3d/core/log.h"
 #include "ret3d/io/detections.h"
+#include "parallel.h"
 
 namespace ret3d {
 namespace eval {
@@ -52,26 +54,56 @@ void fillPredBoxesFromLabels(EvalFrame& frame, const kitti::Calibration& calib) 
   }
 }
 
+std::vector<kitti::Label> boxesToCameraLabels(const std::vector<Box>& boxes, const kitti::Calibration& calib,
+                                              const Eigen::Vector2d& image_size) {
+  std::vector<kitti::Label> out;
+  for (const Box& b : boxes) {
+    kitti::Label l = kitti::boxToLabel(b, calib, image_size);
+    if (b.label == ObjectClass::Unknown || l.z <= 0) continue;  // behind the camera
+    const auto& bb = l.bbox;
+    if (!(bb[2] > bb[0] && bb[3] > bb[1])) continue;  // projects outside the image
+    l.truncated = 0;
+    l.occluded = 0;
+    out.push_back(std::move(l));
+  }
+  return out;
+}
+
 void fillLabelsFromBoxes(EvalFrame& frame, const kitti::Calibration& calib, const Eigen::Vector2d& image_size) {
-  const auto convert = [&](const std::vector<Box>& boxes, const std::vector<char>* ignore, bool is_gt) {
-    std::vector<kitti::Label> out;
-    for (std::size_t i = 0; i < boxes.size(); ++i) {
-      const Box& b = boxes[i];
-      if (b.label == ObjectClass::Unknown) continue;
-      kitti::Label l = kitti::boxToLabel(b, calib, image_size);
-      if (l.z <= 0) continue;  // behind the camera
-      const auto& bb = l.bbox;
-      if (!(bb[2] > bb[0] && bb[3] > bb[1])) continue;  // projects outside the image
-      if (ignore && (*ignore)[i]) l.type = b.label == ObjectClass::Car ? "Van" : "Person_sitting";
-      l.truncated = 0;
-      l.occluded = 0;
-      if (is_gt) l.score.reset();
-      out.push_back(std::move(l));
-    }
-    return out;
-  };
-  frame.gt_labels = convert(frame.gt_boxes, &frame.gt_ignore, true);
-  frame.pred_labels = convert(frame.pred_boxes, nullptr, false);
+  std::vector<Box> gt = frame.gt_boxes;
+  for (std::size_t i = 0; i < gt.size() && i < frame.gt_ignore.size(); ++i) {
+    if (frame.gt_ignore[i]) gt[i].label = ObjectClass::Unknown;  // neighbouring classes: re-added below
+  }
+  frame.gt_labels = boxesToCameraLabels(gt, calib, image_size);
+  for (auto& l : frame.gt_labels) l.score.reset();
+  for (std::size_t i = 0; i < frame.gt_ignore.size() && i < frame.gt_boxes.size(); ++i) {
+    if (!frame.gt_ignore[i]) continue;
+    Box b = frame.gt_boxes[i];
+    auto ls = boxesToCameraLabels({b}, calib, image_size);
+    if (ls.empty()) continue;
+    ls[0].type = b.label == ObjectClass::Car ? "Van" : "Person_sitting";
+    ls[0].score.reset();
+    frame.gt_labels.push_back(ls[0]);
+  }
+  frame.pred_labels = boxesToCameraLabels(frame.pred_boxes, calib, image_size);
+}
+
+std::size_t countGroundTruthPoints(EvalData& data, int threads,
+                                   const std::function<void(std::size_t, std::size_t)>& progress) {
+  std::vector<std::size_t> todo;
+  for (std::size_t i = 0; i < data.frames.size(); ++i) {
+    if (!data.frames[i].velodyne_path.empty() && !data.frames[i].gt_boxes.empty()) todo.push_back(i);
+  }
+  detail::ProgressCounter counter(progress, todo.size());
+  detail::parallelFor(todo.size(), threads, [&](std::size_t k) {
+    EvalFrame& f = data.frames[todo[k]];
+    const PointCloud cloud = kitti::readVelodyne(f.velodyne_path);
+    const std::vector<std::uint32_t> counts = countPointsInBoxes(f.gt_boxes, cloud);
+    for (std::size_t b = 0; b < counts.size(); ++b) f.gt_boxes[b].num_points = counts[b];
+    counter.tick();
+  });
+  if (!todo.empty()) data.gt_has_point_counts = true;
+  return todo.size();
 }
 
 std::vector<std::string> parseSequenceList(const std::string& text) {
@@ -136,6 +168,7 @@ EvalData loadKittiTracking(const std::string& gt_root, const std::string& pred_d
     if (!ds.hasLabels(seq)) throw std::runtime_error(ds.labelPath(seq) + ": missing (sequence " + seq + ")");
     const auto labels = kitti::readTrackingLabels(ds.labelPath(seq));
     const kitti::Calibration calib = kitti::readCalibration(ds.calibPath(seq));
+    data.calibrations[seq] = calib;
     std::map<int, std::vector<kitti::Label>> gt_by_frame;
     int last = -1;
     for (const auto& l : labels) {

@@ -48,18 +48,17 @@ double horizontalRange(const Box& b) { return std::hypot(b.x, b.y); }
 
 // Greedy matching of one frame under one configuration; appends every counted prediction to `out` and returns the
 // number of valid ground truth.
-int matchFrame(const ClassFrame& cf, const std::vector<char>& gt_valid, const std::vector<char>& gt_used,
-               const std::vector<char>& pred_used, double threshold, std::vector<Scored>& out) {
+int matchFrame(const ClassFrame& cf, const std::vector<char>& gt_valid, const std::vector<char>& pred_used,
+               double threshold, std::vector<Scored>& out) {
   const std::size_t ng = cf.gt.size();
   std::vector<char> taken(ng, 0);
   int n_valid = 0;
-  for (std::size_t g = 0; g < ng; ++g) n_valid += gt_used[g] && gt_valid[g];
+  for (std::size_t g = 0; g < ng; ++g) n_valid += gt_valid[g];
   for (std::size_t p = 0; p < cf.pred.size(); ++p) {
     if (!pred_used[p]) continue;
     int best = -1, best_ignored = -1;
     double best_iou = threshold, best_ignored_iou = threshold;
     for (std::size_t g = 0; g < ng; ++g) {
-      if (!gt_used[g]) continue;
       const double o = cf.iou[p * ng + g];
       if (gt_valid[g]) {
         if (!taken[g] && o >= best_iou) {
@@ -128,6 +127,7 @@ WaymoResult evaluateWaymo(const std::vector<EvalFrame>& frames, const WaymoOptio
 
     // Per frame: the class's boxes and their IoUs (computed once, shared by every level and range).
     std::vector<ClassFrame> cfs(frames.size());
+    std::vector<std::size_t> dropped(frames.size(), 0);
     detail::parallelFor(frames.size(), options.threads, [&](std::size_t i) {
       const EvalFrame& f = frames[i];
       ClassFrame& cf = cfs[i];
@@ -135,7 +135,10 @@ WaymoResult evaluateWaymo(const std::vector<EvalFrame>& frames, const WaymoOptio
         const Box& b = f.gt_boxes[g];
         if (b.label != cr.cls) continue;
         const bool ignore = g < f.gt_ignore.size() && f.gt_ignore[g];
-        if (options.use_point_counts && b.num_points == 0 && !ignore) continue;  // not in the ground truth
+        if (options.use_point_counts && b.num_points == 0 && !ignore) {  // not in the ground truth
+          ++dropped[i];
+          continue;
+        }
         cf.gt.push_back(&b);
         cf.gt_ignore.push_back(ignore);
       }
@@ -148,13 +151,7 @@ WaymoResult evaluateWaymo(const std::vector<EvalFrame>& frames, const WaymoOptio
         for (std::size_t g = 0; g < cf.gt.size(); ++g) cf.iou[p * cf.gt.size() + g] = iou3d(*cf.pred[p], *cf.gt[g]);
       }
     });
-    for (std::size_t i = 0; i < frames.size(); ++i) {
-      for (const Box& b : frames[i].gt_boxes) {
-        if (c == 0 && options.use_point_counts && b.num_points == 0 && b.label != ObjectClass::Unknown) {
-          ++result.dropped_empty_gt;
-        }
-      }
-    }
+    for (std::size_t n : dropped) result.dropped_empty_gt += n;
     progress.tick();
 
     // Configurations: each level over all ranges, then each (range, level).
@@ -165,10 +162,9 @@ WaymoResult evaluateWaymo(const std::vector<EvalFrame>& frames, const WaymoOptio
       const int range = static_cast<int>(k / kWaymoNumLevels) - 1;  // -1: all ranges
       std::vector<Scored> dets;
       int num_gt = 0;
-      std::vector<char> valid, gt_used, pred_used;
+      std::vector<char> valid, pred_used;
       for (const ClassFrame& cf : cfs) {
         valid.assign(cf.gt.size(), 1);
-        gt_used.assign(cf.gt.size(), 1);
         pred_used.assign(cf.pred.size(), 1);
         for (std::size_t g = 0; g < cf.gt.size(); ++g) {
           const bool level2 =
@@ -184,7 +180,7 @@ WaymoResult evaluateWaymo(const std::vector<EvalFrame>& frames, const WaymoOptio
             pred_used[p] = r >= options.ranges[range].min && r < options.ranges[range].max;
           }
         }
-        num_gt += matchFrame(cf, valid, gt_used, pred_used, cr.iou_threshold, dets);
+        num_gt += matchFrame(cf, valid, pred_used, cr.iou_threshold, dets);
       }
       WaymoCurve curve = curveFrom(std::move(dets), num_gt);
       if (range < 0) {

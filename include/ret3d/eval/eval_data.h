@@ -4,6 +4,9 @@
 // layouts of io/detections.h, or boxes from a bag (converted to labels with a calibration, see fillLabelsFromBoxes).
 #pragma once
 
+#include <cstddef>
+#include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -42,6 +45,7 @@ struct EvalData {
   bool gt_has_track_ids = false;
   bool pred_has_track_ids = false;
   bool gt_has_point_counts = false;  // some ground-truth box has num_points > 0
+  std::map<std::string, kitti::Calibration> calibrations;  // per sequence ("" for a single one), when read
 };
 
 // ---- label <-> box conversions used by the loaders ----
@@ -53,6 +57,9 @@ void fillPredBoxesFromLabels(EvalFrame& frame, const kitti::Calibration& calib);
 // LiDAR boxes -> camera labels for the KITTI metrics: each box through kitti::boxToLabel, kept only when its centre
 // is in front of the camera and its projected 2D box (clipped to the image) overlaps the image. Ground truth gets
 // truncated/occluded 0 (a bag carries neither), so the difficulty then depends on the 2D box height alone.
+// The conversion itself: boxes in front of the camera whose projection overlaps the image, as camera labels.
+std::vector<kitti::Label> boxesToCameraLabels(const std::vector<Box>& boxes, const kitti::Calibration& calib,
+                                              const Eigen::Vector2d& image_size = Eigen::Vector2d(1242, 375));
 void fillLabelsFromBoxes(EvalFrame& frame, const kitti::Calibration& calib,
                          const Eigen::Vector2d& image_size = Eigen::Vector2d(1242, 375));
 
@@ -65,6 +72,11 @@ EvalData loadKittiTracking(const std::string& gt_root, const std::string& pred_d
 // A KITTI object folder (label_2, calib) with per-frame result files. As the devkit's offline variant, the frames
 // evaluated are those with a result file; when there are none at all, every labelled frame (with no predictions).
 EvalData loadKittiObject(const std::string& gt_root, const std::string& pred_dir);
+
+// Counts the scan's points inside every ground-truth box (Box::num_points) for frames with a velodyne_path, on
+// `threads` threads; sets gt_has_point_counts when some frame was counted. Returns the number of frames counted.
+std::size_t countGroundTruthPoints(EvalData& data, int threads = 2,
+                                   const std::function<void(std::size_t, std::size_t)>& progress = nullptr);
 
 // Parses "1,3-5,0007" into {"0001","0003","0004","0005","0007"} (four-digit sequence names).
 std::vector<std::string> parseSequenceList(const std::string& text);

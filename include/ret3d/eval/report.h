@@ -1,0 +1,50 @@
+// The evaluation report: metrics.json (flat keys, percent 0-100 except counts), report.md (tables a person reads:
+// inputs, thresholds, counts, results) and PNG precision-recall plots drawn by gnuplot.
+//
+// metrics.json keys (read by other tools; exactly these names):
+//   kitti.<Class>.<3d|bev|2d|aos>.<R11|R40>.<easy|moderate|hard>     strict IoU 0.7 / 0.5 / 0.5
+//   waymo.<Class|mean>.<L1|L2>.<AP|APH>
+//   mot.<Class>.<MOTA|MOTP|IDSW|FRAG|MT|ML|HOTA|DetA|AssA>            IDSW, FRAG: counts; MT, ML: % of GT tracks
+// and, under other prefixes: kitti_loose.* (IoU 0.5 / 0.25 / 0.25, same layout as kitti.*), waymo_range.<Class>.
+// <0-30|30-50|50+>.<L1|L2>.<AP|APH>, mot_detail.<Class>.<...> (TP, FP, FN, PT, GT tracks, DetRe, DetPr, AssRe,
+// AssPr, LocA), count.* (frames, objects, ground truth per difficulty).
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "ret3d/eval/kitti_ap.h"
+#include "ret3d/eval/mot_metrics.h"
+#include "ret3d/eval/waymo_ap.h"
+
+namespace ret3d {
+namespace eval {
+
+struct EvalReport {
+  std::string gt_source, pred_source;  // descriptions of what was read
+  std::size_t num_frames = 0, num_gt = 0, num_pred = 0;
+  std::vector<std::string> notes;  // conversions and choices worth stating (e.g. bag -> camera labels)
+  double seconds = 0;              // evaluation time
+
+  const KittiResult* kitti = nullptr;
+  const KittiResult* kitti_loose = nullptr;
+  const WaymoResult* waymo = nullptr;
+  WaymoOptions waymo_options;
+  const MotResult* mot = nullptr;
+  MotOptions mot_options;
+};
+
+// All numbers of the report under their metrics.json keys (sorted).
+std::map<std::string, double> metricsMap(const EvalReport& report);
+// The short table printed on stdout: moderate KITTI AP (3D/BEV R40), Waymo L1/L2 APH, MOTA/HOTA.
+std::string headlineTable(const EvalReport& report);
+// Writes DIR/metrics.json, DIR/report.md and DIR/plots/*.png (plots skipped, with a warning, when gnuplot is
+// missing). Creates DIR. Returns the PNG files written.
+std::vector<std::string> writeReport(const std::string& dir, const EvalReport& report);
+
+// Runs `gnuplot script` as a subprocess (no shell); true on success.
+bool runGnuplot(const std::string& script_path);
+
+}  // namespace eval
+}  // namespace ret3d

@@ -1,0 +1,441 @@
+#include "ret3d/eval/report.h"
+
+#include <spawn.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include "ret3d/core/log.h"
+
+extern char** environ;
+
+namespace ret3d {
+namespace eval {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const char* const kAos = "aos";
+
+std::string fmt(double v, int decimals = 2) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+  return buf;
+}
+
+void addKitti(std::map<std::string, double>& m, const std::string& prefix, const KittiResult& r) {
+  for (const auto& c : r.classes) {
+    const std::string cls = className(c.cls);
+    for (int d = 0; d < kKittiNumDifficulties; ++d) {
+      const std::string diff = difficultyKey(static_cast<KittiDifficulty>(d));
+      for (int mi = 0; mi < kKittiNumMetrics; ++mi) {
+        const std::string base = prefix + "." + cls + "." + metricKey(static_cast<KittiMetric>(mi));
+        m[base + ".R11." + diff] = c.curves[mi][d].ap11();
+        m[base + ".R40." + diff] = c.curves[mi][d].ap40();
+      }
+      if (r.aos_valid) {
+        m[prefix + "." + cls + "." + kAos + ".R11." + diff] = c.aos[d].ap11();
+        m[prefix + "." + cls + "." + kAos + ".R40." + diff] = c.aos[d].ap40();
+      }
+    }
+  }
+}
+
+const KittiCurve& kittiCurve(const KittiClassResult& c, int metric_or_aos, int d) {
+  return metric_or_aos < kKittiNumMetrics ? c.curves[metric_or_aos][d] : c.aos[d];
+}
+
+const char* kittiMetricTitle(int i) {
+  static const char* const titles[] = {"2D", "BEV", "3D", "AOS"};
+  return titles[i];
+}
+
+std::string pathJoin(const std::string& a, const std::string& b) { return (fs::path(a) / b).string(); }
+
+void writeFile(const std::string& path, const std::string& text) {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error(path + ": cannot write");
+  out << text;
+  if (!out) throw std::runtime_error(path + ": write failed");
+}
+
+std::string safeName(std::string s) {
+  for (char& ch : s) {
+    if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
+  }
+  return s;
+}
+
+// A gnuplot script for one PNG; `series` are (data file, using-columns, title).
+struct Series {
+  std::string data, columns, title;
+};
+
+bool plot(const std::string& dir, const std::string& name, const std::string& title, const std::string& ylabel,
+          const std::vector<Series>& series) {
+  std::ostringstream gp;
+  gp << "set terminal pngcairo size 640,480 enhanced font 'DejaVu Sans,11'\n"
+     << "set output '" << pathJoin(dir, name + ".png") << "'\n"
+     << "set title \"" << title << "\" noenhanced\n"
+     << "set xlabel 'Recall'\nset ylabel '" << ylabel << "'\n"
+     << "set xrange [0:1]\nset yrange [0:1.05]\nset grid\nset key bottom left box opaque noenhanced\n"
+     << "plot ";
+  for (std::size_t i = 0; i < series.size(); ++i) {
+    if (i) gp << ", ";
+    gp << "'" << pathJoin(dir, series[i].data) << "' using " << series[i].columns << " with lines lw 2 title \""
+       << series[i].title << "\"";
+  }
+  gp << "\n";
+  const std::string script = pathJoin(dir, name + ".gp");
+  writeFile(script, gp.str());
+  return runGnuplot(script);
+}
+
+}  // namespace
+
+bool runGnuplot(const std::string& script_path) {
+  std::string prog = "gnuplot";
+  std::vector<char*> argv = {prog.data(), const_cast<char*>(script_path.c_str()), nullptr};
+  pid_t pid = 0;
+  if (posix_spawnp(&pid, "gnuplot", nullptr, nullptr, argv.data(), environ) != 0) return false;
+  int status = 0;
+  if (waitpid(pid, &status, 0) < 0) return false;
+  return WIFEXITED(status) && WEXITSTATUS(status) == 0;
+}
+
+std::map<std::string, double> metricsMap(const EvalReport& r) {
+  std::map<std::string, double> m;
+  m["count.frames"] = static_cast<double>(r.num_frames);
+  m["count.gt"] = static_cast<double>(r.num_gt);
+  m["count.pred"] = static_cast<double>(r.num_pred);
+  if (r.kitti) {
+    addKitti(m, "kitti", *r.kitti);
+    for (const auto& c : r.kitti->classes) {
+      const std::string cls = className(c.cls);
+      m["count.kitti." + cls + ".det"] = c.num_det;
+      for (int d = 0; d < kKittiNumDifficulties; ++d) {
+        m["count.kitti." + cls + ".gt." + difficultyKey(static_cast<KittiDifficulty>(d))] = c.curves[2][d].num_gt;
+      }
+    }
+  }
+  if (r.kitti_loose) addKitti(m, "kitti_loose", *r.kitti_loose);
+  if (r.waymo) {
+    for (int l = 0; l < kWaymoNumLevels; ++l) {
+      const std::string level = levelKey(static_cast<WaymoLevel>(l));
+      for (const auto& c : r.waymo->classes) {
+        const std::string cls = className(c.cls);
+        m["waymo." + cls + "." + level + ".AP"] = c.levels[l].ap;
+        m["waymo." + cls + "." + level + ".APH"] = c.levels[l].aph;
+        m["count.waymo." + cls + "." + level + ".gt"] = c.levels[l].num_gt;
+        for (std::size_t k = 0; k < c.ranges.size() && k < r.waymo_options.ranges.size(); ++k) {
+          const std::string base = "waymo_range." + cls + "." + r.waymo_options.ranges[k].name + "." + level;
+          m[base + ".AP"] = c.ranges[k][l].ap;
+          m[base + ".APH"] = c.ranges[k][l].aph;
+        }
+      }
+      m["waymo.mean." + level + ".AP"] = r.waymo->mean_ap[l];
+      m["waymo.mean." + level + ".APH"] = r.waymo->mean_aph[l];
+    }
+  }
+  if (r.mot) {
+    for (const auto& c : r.mot->classes) {
+      const std::string p = "mot." + std::string(className(c.cls)) + ".";
+      const double tracks = std::max(1, c.clear.num_gt_tracks);
+      m[p + "MOTA"] = c.clear.mota;
+      m[p + "MOTP"] = c.clear.motp;
+      m[p + "IDSW"] = c.clear.idsw;
+      m[p + "FRAG"] = c.clear.frag;
+      m[p + "MT"] = 100.0 * c.clear.mt / tracks;
+      m[p + "ML"] = 100.0 * c.clear.ml / tracks;
+      m[p + "HOTA"] = c.hota.hota;
+      m[p + "DetA"] = c.hota.deta;
+      m[p + "AssA"] = c.hota.assa;
+      const std::string q = "mot_detail." + std::string(className(c.cls)) + ".";
+      m[q + "TP"] = c.clear.tp;
+      m[q + "FP"] = c.clear.fp;
+      m[q + "FN"] = c.clear.fn;
+      m[q + "PT"] = 100.0 * c.clear.pt / tracks;
+      m[q + "GT_tracks"] = c.clear.num_gt_tracks;
+      m[q + "pred_tracks"] = c.num_pred_tracks;
+      m[q + "DetRe"] = c.hota.detre;
+      m[q + "DetPr"] = c.hota.detpr;
+      m[q + "AssRe"] = c.hota.assre;
+      m[q + "AssPr"] = c.hota.asspr;
+      m[q + "LocA"] = c.hota.loca;
+    }
+  }
+  return m;
+}
+
+std::string headlineTable(const EvalReport& r) {
+  std::ostringstream o;
+  char line[256];
+  if (r.kitti) {
+    o << "KITTI AP (devkit, R40; R11 in brackets)  easy / moderate / hard\n";
+    for (const auto& c : r.kitti->classes) {
+      for (int mi : {2, 1, 0}) {
+        const auto& cv = c.curves[mi];
+        std::snprintf(line, sizeof line, "  %-10s %-3s @%.2f  %6.2f / %6.2f / %6.2f   [%6.2f / %6.2f / %6.2f]\n",
+                      className(c.cls), kittiMetricTitle(mi), c.min_overlap, cv[0].ap40(), cv[1].ap40(),
+                      cv[2].ap40(), cv[0].ap11(), cv[1].ap11(), cv[2].ap11());
+        o << line;
+      }
+    }
+  }
+  if (r.waymo) {
+    o << "Waymo-style (3D IoU, 360 deg)            L1 AP / APH      L2 AP / APH\n";
+    for (const auto& c : r.waymo->classes) {
+      std::snprintf(line, sizeof line, "  %-10s @%.2f                    %6.2f / %6.2f   %6.2f / %6.2f\n",
+                    className(c.cls), c.iou_threshold, c.levels[0].ap, c.levels[0].aph, c.levels[1].ap,
+                    c.levels[1].aph);
+      o << line;
+    }
+    std::snprintf(line, sizeof line, "  %-10s                          %6.2f / %6.2f   %6.2f / %6.2f\n", "mean",
+                  r.waymo->mean_ap[0], r.waymo->mean_aph[0], r.waymo->mean_ap[1], r.waymo->mean_aph[1]);
+    o << line;
+  }
+  if (r.mot) {
+    o << "Tracking (" << similarityName(r.mot_options.similarity) << " >= " << r.mot_options.threshold
+      << ")   MOTA    MOTP   IDSW   FRAG    HOTA    DetA    AssA\n";
+    for (const auto& c : r.mot->classes) {
+      std::snprintf(line, sizeof line, "  %-10s          %7.2f %7.2f %6d %6d %7.2f %7.2f %7.2f\n", className(c.cls),
+                    c.clear.mota, c.clear.motp, c.clear.idsw, c.clear.frag, c.hota.hota, c.hota.deta, c.hota.assa);
+      o << line;
+    }
+  }
+  return o.str();
+}
+
+namespace {
+
+std::string metricsJson(const std::map<std::string, double>& m) {
+  std::ostringstream o;
+  o << "{\n";
+  std::size_t i = 0;
+  for (const auto& [k, v] : m) {
+    o << "  \"" << k << "\": ";
+    if (!std::isfinite(v)) {
+      o << "null";
+    } else if (v == std::floor(v) && std::abs(v) < 1e15) {
+      o << static_cast<long long>(v);
+    } else {
+      o << fmt(v, 4);
+    }
+    o << (++i < m.size() ? ",\n" : "\n");
+  }
+  o << "}\n";
+  return o.str();
+}
+
+void kittiTable(std::ostringstream& md, const KittiResult& k, const std::vector<std::string>& pngs,
+                const std::string& plot_prefix) {
+  md << "| class | metric | IoU | R11 easy | R11 moderate | R11 hard | R40 easy | R40 moderate | R40 hard |\n"
+     << "| --- | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+  for (const auto& c : k.classes) {
+    for (int mi : {2, 1, 0, 3}) {
+      if (mi == 3 && !k.aos_valid) continue;
+      md << "| " << className(c.cls) << " | " << kittiMetricTitle(mi) << " | " << fmt(c.min_overlap) << " |";
+      for (int d = 0; d < 3; ++d) md << " " << fmt(kittiCurve(c, mi, d).ap11()) << " |";
+      for (int d = 0; d < 3; ++d) md << " " << fmt(kittiCurve(c, mi, d).ap40()) << " |";
+      md << "\n";
+    }
+  }
+  md << "\n";
+  if (!plot_prefix.empty()) {
+    for (const auto& png : pngs) {
+      if (png.rfind(plot_prefix, 0) == 0) md << "![" << png << "](plots/" << png << ")\n";
+    }
+    md << "\n";
+  }
+}
+
+}  // namespace
+
+std::vector<std::string> writeReport(const std::string& dir, const EvalReport& r) {
+  fs::create_directories(dir);
+  const std::string plots = pathJoin(dir, "plots");
+  fs::create_directories(plots);
+  const auto metrics = metricsMap(r);
+  writeFile(pathJoin(dir, "metrics.json"), metricsJson(metrics));
+
+  // ---- plots ----
+  std::vector<std::string> pngs;
+  bool gnuplot_ok = true;
+  const auto draw = [&](const std::string& name, const std::string& title, const std::string& ylabel,
+                        const std::vector<Series>& series) {
+    if (!gnuplot_ok) return;
+    if (plot(plots, name, title, ylabel, series)) {
+      pngs.push_back(name + ".png");
+    } else {
+      gnuplot_ok = false;
+      RET3D_WARN("gnuplot failed or is missing: no plots (metrics.json and report.md are complete)");
+    }
+  };
+  if (r.kitti) {
+    for (const auto& c : r.kitti->classes) {
+      for (int mi = 0; mi < 4; ++mi) {
+        if (mi == 3 && !r.kitti->aos_valid) continue;
+        const std::string name = std::string("kitti_") + className(c.cls) + "_" + safeName(kittiMetricTitle(mi));
+        std::ostringstream data;
+        data << "# recall easy moderate hard (devkit's 41 samples, interpolated)\n";
+        for (int i = 0; i < kKittiSamplePoints; ++i) {
+          data << fmt(i / 40.0, 3);
+          for (int d = 0; d < 3; ++d) data << " " << fmt(kittiCurve(c, mi, d).precision[i], 6);
+          data << "\n";
+        }
+        writeFile(pathJoin(plots, name + ".txt"), data.str());
+        std::vector<Series> s;
+        for (int d = 0; d < 3; ++d) {
+          const auto& cv = kittiCurve(c, mi, d);
+          const std::string label = std::string(d == 0 ? "Easy" : d == 1 ? "Moderate" : "Hard") + " (R40 " +
+                                    fmt(cv.ap40()) + ", R11 " + fmt(cv.ap11()) + ", " + std::to_string(cv.num_gt) +
+                                    " GT)";
+          s.push_back({name + ".txt", "1:" + std::to_string(d + 2), label});
+        }
+        const std::string title = std::string("KITTI ") + className(c.cls) + " " + kittiMetricTitle(mi) +
+                                  (mi == 3 ? " (2D match" : " (IoU") + " >= " + fmt(c.min_overlap) + ")";
+        draw(name, title, mi == 3 ? "Orientation similarity" : "Precision", s);
+      }
+    }
+  }
+  if (r.waymo) {
+    for (const auto& c : r.waymo->classes) {
+      const std::string name = std::string("waymo_") + className(c.cls);
+      std::vector<Series> s;
+      for (int l = 0; l < kWaymoNumLevels; ++l) {
+        const auto& cv = c.levels[l];
+        const std::string data_name = name + "_" + levelKey(static_cast<WaymoLevel>(l)) + ".txt";
+        std::ostringstream data;
+        data << "# recall precision recall_h precision_h (one row per score cutoff)\n0 1 0 1\n";
+        for (std::size_t i = 0; i < cv.recall.size(); ++i) {
+          data << fmt(cv.recall[i], 6) << " " << fmt(cv.precision[i], 6) << " " << fmt(cv.recall_h[i], 6) << " "
+               << fmt(cv.precision_h[i], 6) << "\n";
+        }
+        writeFile(pathJoin(plots, data_name), data.str());
+        const std::string lv = levelKey(static_cast<WaymoLevel>(l));
+        s.push_back({data_name, "1:2", lv + " AP " + fmt(cv.ap) + " (" + std::to_string(cv.num_gt) + " GT)"});
+        s.push_back({data_name, "3:4", lv + " APH " + fmt(cv.aph)});
+      }
+      draw(name, std::string("Waymo-style ") + className(c.cls) + " (3D IoU >= " + fmt(c.iou_threshold) + ")",
+           "Precision", s);
+    }
+  }
+
+  // ---- report.md ----
+  std::ostringstream md;
+  md << "# ret3d evaluation report\n\n## Inputs\n\n"
+     << "| | |\n| --- | --- |\n"
+     << "| ground truth | " << r.gt_source << " |\n"
+     << "| predictions | " << r.pred_source << " |\n"
+     << "| frames | " << r.num_frames << " |\n"
+     << "| ground-truth objects (all types, incl. DontCare) | " << r.num_gt << " |\n"
+     << "| predictions | " << r.num_pred << " |\n"
+     << "| evaluation time | " << fmt(r.seconds) << " s |\n\n";
+  if (!r.notes.empty()) {
+    md << "Notes:\n\n";
+    for (const auto& n : r.notes) md << "- " << n << "\n";
+    md << "\n";
+  }
+  if (r.kitti) {
+    md << "## KITTI object detection AP (official devkit rules)\n\n"
+       << "Computed as the KITTI object devkit (evaluate_object_3d_offline, with the 2017 minimum-height fix) in "
+          "camera coordinates. Difficulty: easy = 2D box height >= 40 px, occlusion 0, truncation <= 0.15; moderate "
+          "= >= 25 px, occlusion <= 1, truncation <= 0.3; hard = >= 25 px, occlusion <= 2, truncation <= 0.5. "
+          "Van is ignored for Car and Person_sitting for Pedestrian; detections in DontCare regions are not false "
+          "positives; detections below the minimum height are ignored. R11 = the devkit's printed 11-point AP "
+          "(mean precision at its sample points 0, 4, ..., 40 of 41); R40 = mean precision at recall 1/40 .. 40/40. AOS uses the 2D "
+          "matching. Values in percent.\n\n"
+       << "Ground truth counted (valid at each difficulty) and detections:\n\n"
+       << "| class | easy | moderate | hard | detections |\n| --- | ---: | ---: | ---: | ---: |\n";
+    for (const auto& c : r.kitti->classes) {
+      md << "| " << className(c.cls) << " | " << c.curves[2][0].num_gt << " | " << c.curves[2][1].num_gt << " | "
+         << c.curves[2][2].num_gt << " | " << c.num_det << " |\n";
+    }
+    md << "\n### Strict IoU thresholds (Car 0.7, Pedestrian 0.5, Cyclist 0.5)\n\n";
+    kittiTable(md, *r.kitti, pngs, "kitti_");
+    if (r.kitti_loose) {
+      md << "### Loose IoU thresholds (Car 0.5, Pedestrian 0.25, Cyclist 0.25; keys kitti_loose.*)\n\n";
+      kittiTable(md, *r.kitti_loose, pngs, "");
+    }
+  }
+  if (r.waymo) {
+    const auto& o = r.waymo_options;
+    md << "## Waymo-style AP / APH (LiDAR frame, 360 degrees)\n\n"
+       << "3D IoU thresholds: Car " << fmt(o.iou_threshold[0]) << ", Pedestrian " << fmt(o.iou_threshold[1])
+       << ", Cyclist " << fmt(o.iou_threshold[2]) << ". Heading accuracy of a match: 1 - |dyaw| / pi (wrapped). ";
+    if (r.waymo->used_point_counts) {
+      md << "Levels from the LiDAR points in each ground-truth box: 0 points -> dropped (" << r.waymo->dropped_empty_gt
+         << " boxes), 1.." << o.level2_max_points << " -> LEVEL_2, more -> LEVEL_1; L1 ignores LEVEL_2 boxes, L2 "
+         << "evaluates both. ";
+    } else {
+      md << "No point counts were available (no counts in the ground truth, no scans): every box is LEVEL_1, so L1 "
+            "and L2 agree. ";
+    }
+    md << "Matching: predictions in descending score order take the unmatched ground truth of highest IoU; AP = area "
+          "under the max-precision-interpolated precision-recall curve (every score cutoff); APH the same on "
+          "heading-weighted precision and recall. Van / Person_sitting are ignore regions.\n\n"
+       << "| class | L1 AP | L1 APH | L2 AP | L2 APH | L1 GT | L2 GT | TP (L2) | FP (L2) |\n"
+       << "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+    for (const auto& c : r.waymo->classes) {
+      md << "| " << className(c.cls) << " | " << fmt(c.levels[0].ap) << " | " << fmt(c.levels[0].aph) << " | "
+         << fmt(c.levels[1].ap) << " | " << fmt(c.levels[1].aph) << " | " << c.levels[0].num_gt << " | "
+         << c.levels[1].num_gt << " | " << c.levels[1].num_tp << " | " << c.levels[1].num_fp << " |\n";
+    }
+    md << "| mean | " << fmt(r.waymo->mean_ap[0]) << " | " << fmt(r.waymo->mean_aph[0]) << " | "
+       << fmt(r.waymo->mean_ap[1]) << " | " << fmt(r.waymo->mean_aph[1]) << " | | | | |\n\n";
+    md << "By range (horizontal distance from the sensor; ground truth outside the bin is ignored, predictions "
+          "outside it dropped), L2 AP / APH:\n\n| class |";
+    for (const auto& b : o.ranges) md << " " << b.name << " m |";
+    md << "\n| --- |";
+    for (std::size_t k = 0; k < o.ranges.size(); ++k) md << " ---: |";
+    md << "\n";
+    for (const auto& c : r.waymo->classes) {
+      md << "| " << className(c.cls) << " |";
+      for (const auto& rb : c.ranges) {
+        md << " " << fmt(rb[1].ap) << " / " << fmt(rb[1].aph) << " (" << rb[1].num_gt << " GT) |";
+      }
+      md << "\n";
+    }
+    md << "\n";
+    for (const auto& png : pngs) {
+      if (png.rfind("waymo_", 0) == 0) md << "![" << png << "](plots/" << png << ")\n";
+    }
+    md << "\n";
+  }
+  if (r.mot) {
+    const auto& o = r.mot_options;
+    md << "## Tracking (CLEAR MOT and HOTA, per class)\n\n"
+       << "Similarity: " << similarityName(o.similarity);
+    if (o.similarity == MotSimilarity::CenterDistance) md << " (1 - d / " << fmt(o.zero_distance) << " m)";
+    md << "; CLEAR matches need similarity >= " << fmt(o.threshold) << "; HOTA averages over alpha 0.05..0.95. "
+       << "MOTA, MOTP, HOTA, DetA, AssA in percent; IDSW and FRAG are counts; MT / ML in percent of ground-truth "
+          "tracks (tracked > 80 % / < 20 % of their frames). Definitions as TrackEval. "
+       << r.mot->num_sequences << " sequences; " << r.mot->removed_on_ignore
+       << " predictions on ignored ground truth (Van, Person_sitting) removed.\n\n"
+       << "| class | MOTA | MOTP | IDSW | FRAG | MT | ML | HOTA | DetA | AssA | GT | TP | FP | FN | GT tracks | "
+          "pred tracks |\n| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | "
+          "---: | ---: | ---: | ---: |\n";
+    for (const auto& c : r.mot->classes) {
+      const double tracks = std::max(1, c.clear.num_gt_tracks);
+      md << "| " << className(c.cls) << " | " << fmt(c.clear.mota) << " | " << fmt(c.clear.motp) << " | "
+         << c.clear.idsw << " | " << c.clear.frag << " | " << fmt(100.0 * c.clear.mt / tracks) << " | "
+         << fmt(100.0 * c.clear.ml / tracks) << " | " << fmt(c.hota.hota) << " | " << fmt(c.hota.deta) << " | "
+         << fmt(c.hota.assa) << " | " << c.clear.num_gt << " | " << c.clear.tp << " | " << c.clear.fp << " | "
+         << c.clear.fn << " | " << c.clear.num_gt_tracks << " | " << c.num_pred_tracks << " |\n";
+    }
+    md << "\n";
+  }
+  writeFile(pathJoin(dir, "report.md"), md.str());
+  return pngs;
+}
+
+}  // namespace eval
+}  // namespace ret3d
