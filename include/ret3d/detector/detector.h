@@ -1,0 +1,58 @@
+// The LWD-3D base detector's inference API, shared by the nodelet, the command line and the tests:
+// BEV encoding, network, decoding, rotated NMS per class, and the per-object feature o_i (Ret3D §3.1).
+// No libtorch here (pimpl), so including this header costs nothing.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "ret3d/core/detections.h"
+#include "ret3d/core/types.h"
+#include "ret3d/detector/detector_options.h"
+
+namespace ret3d {
+
+namespace nn {
+class DetectorModel;
+}
+
+// Wall time of each part of the last detect() call, milliseconds.
+struct DetectorTimings {
+  double bev_ms = 0, network_ms = 0, decode_ms = 0, nms_ms = 0;
+  double total() const { return bev_ms + network_ms + decode_ms + nms_ms; }
+};
+
+class Detector {
+ public:
+  // Loads options.inference.model_path, refusing a file whose model differs from options.model (the message lists
+  // what differs); with an empty path the network is freshly initialised (tests). Sets torch's thread count.
+  explicit Detector(const DetectorOptions& options);
+  // Wraps an existing model (training: validation with the model being trained); the options' model part must match.
+  Detector(const DetectorOptions& options, std::shared_ptr<nn::DetectorModel> model);
+  ~Detector();
+  Detector(const Detector&) = delete;
+  Detector& operator=(const Detector&) = delete;
+
+  // previous may be null (first frame); a point p of the previous sweep lies at prev_to_current * p now.
+  // Returns boxes in the current sensor frame (velocity in m/s, score, class) by descending score, and one feature
+  // row per box (feature_dim = featureDim()): the BEV feature at the box centre.
+  Detections detect(const PointCloud& current, const PointCloud* previous = nullptr,
+                    const Eigen::Isometry3d& prev_to_current = Eigen::Isometry3d::Identity());
+
+  const DetectorOptions& options() const { return options_; }
+  const DetectorTimings& lastTimings() const { return timings_; }
+  int featureDim() const;
+  std::int64_t parameterCount() const;
+  nn::DetectorModel& model();
+
+ private:
+  struct Impl;
+  DetectorOptions options_;
+  std::unique_ptr<Impl> impl_;
+  DetectorTimings timings_;
+};
+
+}  // namespace ret3d

@@ -1,0 +1,120 @@
+// Every parameter of the LWD-3D base detector, as plain structs with one loader from YAML
+// (config/detector/*.yaml). The `model` part describes what a trained file must be (it is stored in the file and
+// compared on load); the `inference` part may change freely at run time; `train` drives `ret3d train detector`.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "ret3d/bev/bev_encoder.h"
+#include "ret3d/core/types.h"
+
+namespace ret3d {
+
+enum class HeadType { Anchor, Center };
+const char* headTypeName(HeadType h);  // "anchor", "center"
+
+// The backbone (LWD-3D §2.3): a stride-2 stem, depthwise-separable stages each halving the resolution (strides 4, 8,
+// 16, ...), a transformer block over the coarsest grid, and a decoder (upsample + lateral) back to the output strides.
+struct NetworkOptions {
+  int stem_channels = 16;
+  std::vector<int> stage_channels = {32, 64, 96};
+  std::vector<int> stage_blocks = {1, 2, 2};  // depthwise-separable blocks per stage (the first one strides)
+  int attention_heads = 4;
+  int attention_layers = 1;   // transformer blocks between encoder and decoder (0 = none, for ablation)
+  int decoder_channels = 64;  // also the dimension of the per-object feature o_i
+  int head_channels = 64;
+
+  // Stride of stage i (0-based): 2^(i + 2).
+  int stageStride(int i) const { return 1 << (i + 2); }
+  int maxStride() const { return stageStride(static_cast<int>(stage_channels.size()) - 1); }
+};
+
+struct AnchorHeadOptions {
+  std::vector<int> strides = {4, 8};  // prediction scales (YOLO-style multi-scale)
+  int anchors_per_class = 2;          // k of the k-means per class
+  // An anchor predicts at the coarsest stride whose cell (stride * resolution) is at most this fraction of its
+  // longer side, else at the finest stride.
+  double scale_fraction = 0.6;
+  int neighbour_cells = 2;            // extra positive cells per object (YOLOv5: the two nearest neighbours)
+};
+
+struct CenterHeadOptions {
+  int stride = 4;
+  double gaussian_overlap = 0.1;  // CenterNet radius from the minimum overlap
+  int min_radius = 1;
+};
+
+struct ModelConfig {
+  std::vector<ObjectClass> classes = {ObjectClass::Car, ObjectClass::Pedestrian, ObjectClass::Cyclist};
+  BevGeometry geometry;
+  double density_norm = 64.0;
+  double sweep_interval = 0.1;  // seconds between the two sweeps (velocity targets are per second)
+  NetworkOptions network;
+  HeadType head = HeadType::Center;
+  AnchorHeadOptions anchor;
+  CenterHeadOptions center;
+
+  // The output strides of the head in use, finest first.
+  std::vector<int> headStrides() const;
+  // The stride of the feature map o_i is sampled from (the finest decoder output).
+  int featureStride() const { return headStrides().front(); }
+  // Throws std::invalid_argument naming the field when inconsistent (grid not divisible by the coarsest stride,
+  // a head stride that is not a stage stride, ...).
+  void validate() const;
+};
+
+struct InferenceOptions {
+  std::string model_path;      // empty: the network is freshly initialised (tests, training)
+  int threads = 2;             // torch intra-op threads and BEV workers
+  float score_threshold = 0.3f;
+  int max_candidates = 500;    // per class before NMS
+  int max_detections = 200;    // after NMS
+  double nms_iou = 0.1;        // rotated BEV IoU, per class
+};
+
+struct TrainOptions {
+  int epochs = 40;
+  int batch_size = 4;
+  double learning_rate = 2e-3;
+  double weight_decay = 0.01;
+  double warmup_fraction = 0.05;  // linear warm-up, then cosine decay
+  unsigned seed = 42;
+  double checkpoint_minutes = 5.0;
+  int max_frames = 0;             // 0 = all frames of the dataset
+  // Augmentation (LWD-3D §2.5: rotation, clipping, block input).
+  double rotation_range = 0.785;  // global rotation, uniform in +-range (rad)
+  bool flip = true;               // mirror about the x axis with probability 0.5
+  double scale_min = 0.95, scale_max = 1.05;
+  double crop_probability = 0.3;  // drop points outside a random sub-window (random clipping)
+  double block_probability = 0.3; // drop points in random blocks (block input)
+  // Multi-scale schedule after LWD-3D eq. (4), Scale = 32 (13 + n): here the grid side is 32 (base + n) cells with
+  // n drawn from [n_min, n_max] per batch, centred on the sensor (the metric extent changes, the resolution stays, so
+  // objects keep their size in cells); n_max < n_min = off (the configured grid).
+  int multiscale_base = 12;
+  int multiscale_n_min = 0, multiscale_n_max = -1;
+  // Real KITTI labels cover only the front camera's view: supervise objectness only within +-fov/2 of x (0 = all).
+  double supervised_fov_deg = 0.0;
+  double loss_weight_regression = 2.0;
+  double loss_weight_velocity = 0.5;
+};
+
+struct DetectorOptions {
+  ModelConfig model;
+  InferenceOptions inference;
+  TrainOptions train;
+
+  BevEncoderOptions bevOptions() const;
+};
+
+// Reads a YAML file; every key is optional (defaults above); an unknown key, a wrong type or an invalid value
+// throws std::runtime_error naming the file and the key.
+DetectorOptions loadDetectorOptions(const std::string& path);
+DetectorOptions detectorOptionsFromYaml(const std::string& yaml_text, const std::string& origin = "<string>");
+// The model part as YAML (stored in model files) and back.
+std::string modelConfigToYaml(const ModelConfig& m);
+ModelConfig modelConfigFromYaml(const std::string& yaml_text, const std::string& origin);
+// Differences between two model configs, one readable line each ("geometry.resolution: 0.25 vs 0.2"); empty = equal.
+std::vector<std::string> diffModelConfigs(const ModelConfig& a, const ModelConfig& b);
+
+}  // namespace ret3d

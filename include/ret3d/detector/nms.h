@@ -1,0 +1,16 @@
+// Rotated non-maximum suppression on exact BEV IoU (core bevIoU), per class.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "ret3d/core/types.h"
+
+namespace ret3d {
+
+// Indices of the boxes kept, by descending score: a box is dropped when its BEV IoU with a kept box of the same
+// class exceeds iou_threshold (with per_class = false, of any class). At most max_keep (0 = no limit).
+std::vector<std::size_t> rotatedNms(const std::vector<Box>& boxes, double iou_threshold, bool per_class = true,
+                                    std::size_t max_keep = 0);
+
+}  // namespace ret3d

@@ -1,0 +1,301 @@
+#include "ret3d/detector/detector_options.h"
+
+#include <algorithm>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include <yaml-cpp/yaml.h>
+
+namespace ret3d {
+
+const char* headTypeName(HeadType h) { return h == HeadType::Anchor ? "anchor" : "center"; }
+
+std::vector<int> ModelConfig::headStrides() const {
+  std::vector<int> s = head == HeadType::Anchor ? anchor.strides : std::vector<int>{center.stride};
+  std::sort(s.begin(), s.end());
+  return s;
+}
+
+void ModelConfig::validate() const {
+  auto fail = [](const std::string& m) { throw std::invalid_argument("detector config: " + m); };
+  geometry.validate();
+  if (classes.empty()) fail("classes must not be empty");
+  for (ObjectClass c : classes)
+    if (c == ObjectClass::Unknown) fail("classes: Unknown is not a detectable class");
+  if (network.stage_channels.empty()) fail("network.stage_channels must not be empty");
+  if (network.stage_blocks.size() != network.stage_channels.size())
+    fail("network.stage_blocks must have one entry per stage_channels entry");
+  for (int b : network.stage_blocks)
+    if (b < 1) fail("network.stage_blocks entries must be >= 1");
+  if (network.stem_channels < 1 || network.decoder_channels < 1 || network.head_channels < 1)
+    fail("network channel counts must be positive");
+  if (network.attention_layers > 0 && network.stage_channels.back() % network.attention_heads != 0)
+    fail("network.attention_heads must divide the last stage_channels entry");
+  const int max_stride = network.maxStride();
+  if (geometry.width() % max_stride || geometry.height() % max_stride)
+    fail("the grid (" + geometry.describe() + ") must be divisible by the coarsest stride " +
+         std::to_string(max_stride));
+  const auto strides = headStrides();
+  if (strides.empty()) fail("the head needs at least one stride");
+  for (int s : strides) {
+    bool ok = false;
+    for (std::size_t i = 0; i < network.stage_channels.size(); ++i) ok |= network.stageStride(static_cast<int>(i)) == s;
+    if (!ok) fail("head stride " + std::to_string(s) + " is not a stage stride (4, 8, ... up to " +
+                  std::to_string(max_stride) + ")");
+  }
+  if (head == HeadType::Anchor && anchor.anchors_per_class < 1) fail("anchor.anchors_per_class must be >= 1");
+  if (!(sweep_interval > 0)) fail("sweep_interval must be positive");
+}
+
+BevEncoderOptions DetectorOptions::bevOptions() const {
+  BevEncoderOptions o;
+  o.geometry = model.geometry;
+  o.density_norm = model.density_norm;
+  o.threads = inference.threads;
+  return o;
+}
+
+namespace {
+
+// Reads the keys of one YAML map, refusing any key it was not asked for.
+class MapReader {
+ public:
+  MapReader(const YAML::Node& node, std::string path, std::string origin)
+      : node_(node), path_(std::move(path)), origin_(std::move(origin)) {
+    if (node_ && !node_.IsNull() && !node_.IsMap()) fail(path_.empty() ? "top level" : path_, "expected a map");
+  }
+  template <typename T>
+  void get(const std::string& key, T* value) {
+    known_.insert(key);
+    if (!node_ || node_.IsNull() || !node_[key]) return;
+    try {
+      *value = node_[key].as<T>();
+    } catch (const YAML::Exception& e) {
+      fail(full(key), "wrong type or value (" + std::string(e.what()) + ")");
+    }
+  }
+  MapReader child(const std::string& key) {
+    known_.insert(key);
+    return MapReader(node_ && !node_.IsNull() ? node_[key] : YAML::Node(), full(key), origin_);
+  }
+  void finish() const {
+    if (!node_ || node_.IsNull()) return;
+    for (const auto& kv : node_) {
+      const std::string k = kv.first.as<std::string>();
+      if (!known_.count(k)) fail(full(k), "unknown key");
+    }
+  }
+  [[noreturn]] void fail(const std::string& key, const std::string& msg) const {
+    throw std::runtime_error(origin_ + ": " + key + ": " + msg);
+  }
+  std::string full(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+
+ private:
+  YAML::Node node_;
+  std::string path_, origin_;
+  std::set<std::string> known_;
+};
+
+void readModel(MapReader r, ModelConfig* m) {
+  std::vector<std::string> classes;
+  for (ObjectClass c : m->classes) classes.push_back(className(c));
+  r.get("classes", &classes);
+  m->classes.clear();
+  for (const auto& name : classes) {
+    auto c = classFromName(name);
+    if (!c) r.fail(r.full("classes"), "unknown class '" + name + "' (Car, Pedestrian, Cyclist)");
+    m->classes.push_back(*c);
+  }
+  {
+    MapReader g = r.child("bev");
+    g.get("x_min", &m->geometry.x_min);
+    g.get("x_max", &m->geometry.x_max);
+    g.get("y_min", &m->geometry.y_min);
+    g.get("y_max", &m->geometry.y_max);
+    g.get("z_min", &m->geometry.z_min);
+    g.get("z_max", &m->geometry.z_max);
+    g.get("resolution", &m->geometry.resolution);
+    g.get("density_norm", &m->density_norm);
+    g.get("sweep_interval", &m->sweep_interval);
+    g.finish();
+  }
+  {
+    MapReader n = r.child("network");
+    n.get("stem_channels", &m->network.stem_channels);
+    n.get("stage_channels", &m->network.stage_channels);
+    n.get("stage_blocks", &m->network.stage_blocks);
+    n.get("attention_heads", &m->network.attention_heads);
+    n.get("attention_layers", &m->network.attention_layers);
+    n.get("decoder_channels", &m->network.decoder_channels);
+    n.get("head_channels", &m->network.head_channels);
+    n.finish();
+  }
+  std::string head = headTypeName(m->head);
+  r.get("head", &head);
+  if (head == "anchor") m->head = HeadType::Anchor;
+  else if (head == "center") m->head = HeadType::Center;
+  else r.fail(r.full("head"), "must be 'anchor' or 'center', not '" + head + "'");
+  {
+    MapReader a = r.child("anchor");
+    a.get("strides", &m->anchor.strides);
+    a.get("anchors_per_class", &m->anchor.anchors_per_class);
+    a.get("scale_fraction", &m->anchor.scale_fraction);
+    a.get("neighbour_cells", &m->anchor.neighbour_cells);
+    a.finish();
+  }
+  {
+    MapReader c = r.child("center");
+    c.get("stride", &m->center.stride);
+    c.get("gaussian_overlap", &m->center.gaussian_overlap);
+    c.get("min_radius", &m->center.min_radius);
+    c.finish();
+  }
+  r.finish();
+}
+
+void readInference(MapReader r, InferenceOptions* o) {
+  r.get("model_path", &o->model_path);
+  r.get("threads", &o->threads);
+  r.get("score_threshold", &o->score_threshold);
+  r.get("max_candidates", &o->max_candidates);
+  r.get("max_detections", &o->max_detections);
+  r.get("nms_iou", &o->nms_iou);
+  r.finish();
+  if (o->threads < 1) r.fail(r.full("threads"), "must be >= 1");
+}
+
+void readTrain(MapReader r, TrainOptions* t) {
+  r.get("epochs", &t->epochs);
+  r.get("batch_size", &t->batch_size);
+  r.get("learning_rate", &t->learning_rate);
+  r.get("weight_decay", &t->weight_decay);
+  r.get("warmup_fraction", &t->warmup_fraction);
+  r.get("seed", &t->seed);
+  r.get("checkpoint_minutes", &t->checkpoint_minutes);
+  r.get("max_frames", &t->max_frames);
+  r.get("rotation_range", &t->rotation_range);
+  r.get("flip", &t->flip);
+  r.get("scale_min", &t->scale_min);
+  r.get("scale_max", &t->scale_max);
+  r.get("crop_probability", &t->crop_probability);
+  r.get("block_probability", &t->block_probability);
+  r.get("multiscale_base", &t->multiscale_base);
+  r.get("multiscale_n_min", &t->multiscale_n_min);
+  r.get("multiscale_n_max", &t->multiscale_n_max);
+  r.get("supervised_fov_deg", &t->supervised_fov_deg);
+  r.get("loss_weight_regression", &t->loss_weight_regression);
+  r.get("loss_weight_velocity", &t->loss_weight_velocity);
+  r.finish();
+  if (t->epochs < 1) r.fail(r.full("epochs"), "must be >= 1");
+  if (t->batch_size < 1) r.fail(r.full("batch_size"), "must be >= 1");
+}
+
+YAML::Node parse(const std::string& text, const std::string& origin) {
+  try {
+    return YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error(origin + ": line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  }
+}
+
+void flatten(const YAML::Node& n, const std::string& prefix, std::map<std::string, std::string>* out) {
+  if (n.IsMap()) {
+    for (const auto& kv : n) flatten(kv.second, prefix.empty() ? kv.first.as<std::string>() : prefix + "." + kv.first.as<std::string>(), out);
+  } else {
+    YAML::Emitter e;
+    e << YAML::Flow << n;
+    (*out)[prefix] = e.c_str();
+  }
+}
+
+}  // namespace
+
+DetectorOptions detectorOptionsFromYaml(const std::string& yaml_text, const std::string& origin) {
+  const YAML::Node root = parse(yaml_text, origin);
+  DetectorOptions o;
+  MapReader r(root, "", origin);
+  readModel(r.child("model"), &o.model);
+  readInference(r.child("inference"), &o.inference);
+  readTrain(r.child("train"), &o.train);
+  r.finish();
+  try {
+    o.model.validate();
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(origin + ": " + e.what());
+  }
+  return o;
+}
+
+DetectorOptions loadDetectorOptions(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot open detector config");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return detectorOptionsFromYaml(ss.str(), path);
+}
+
+std::string modelConfigToYaml(const ModelConfig& m) {
+  YAML::Emitter e;
+  e.SetDoublePrecision(15);  // 0.2 stays "0.2", and still round-trips exactly enough for comparisons
+  e << YAML::BeginMap;
+  e << YAML::Key << "classes" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+  for (ObjectClass c : m.classes) e << className(c);
+  e << YAML::EndSeq;
+  e << YAML::Key << "bev" << YAML::Value << YAML::BeginMap;
+  e << YAML::Key << "x_min" << YAML::Value << m.geometry.x_min << YAML::Key << "x_max" << YAML::Value << m.geometry.x_max;
+  e << YAML::Key << "y_min" << YAML::Value << m.geometry.y_min << YAML::Key << "y_max" << YAML::Value << m.geometry.y_max;
+  e << YAML::Key << "z_min" << YAML::Value << m.geometry.z_min << YAML::Key << "z_max" << YAML::Value << m.geometry.z_max;
+  e << YAML::Key << "resolution" << YAML::Value << m.geometry.resolution;
+  e << YAML::Key << "density_norm" << YAML::Value << m.density_norm;
+  e << YAML::Key << "sweep_interval" << YAML::Value << m.sweep_interval;
+  e << YAML::EndMap;
+  e << YAML::Key << "network" << YAML::Value << YAML::BeginMap;
+  e << YAML::Key << "stem_channels" << YAML::Value << m.network.stem_channels;
+  e << YAML::Key << "stage_channels" << YAML::Value << YAML::Flow << m.network.stage_channels;
+  e << YAML::Key << "stage_blocks" << YAML::Value << YAML::Flow << m.network.stage_blocks;
+  e << YAML::Key << "attention_heads" << YAML::Value << m.network.attention_heads;
+  e << YAML::Key << "attention_layers" << YAML::Value << m.network.attention_layers;
+  e << YAML::Key << "decoder_channels" << YAML::Value << m.network.decoder_channels;
+  e << YAML::Key << "head_channels" << YAML::Value << m.network.head_channels;
+  e << YAML::EndMap;
+  e << YAML::Key << "head" << YAML::Value << headTypeName(m.head);
+  e << YAML::Key << "anchor" << YAML::Value << YAML::BeginMap;
+  e << YAML::Key << "strides" << YAML::Value << YAML::Flow << m.anchor.strides;
+  e << YAML::Key << "anchors_per_class" << YAML::Value << m.anchor.anchors_per_class;
+  e << YAML::Key << "scale_fraction" << YAML::Value << m.anchor.scale_fraction;
+  e << YAML::Key << "neighbour_cells" << YAML::Value << m.anchor.neighbour_cells;
+  e << YAML::EndMap;
+  e << YAML::Key << "center" << YAML::Value << YAML::BeginMap;
+  e << YAML::Key << "stride" << YAML::Value << m.center.stride;
+  e << YAML::Key << "gaussian_overlap" << YAML::Value << m.center.gaussian_overlap;
+  e << YAML::Key << "min_radius" << YAML::Value << m.center.min_radius;
+  e << YAML::EndMap;
+  e << YAML::EndMap;
+  return e.c_str();
+}
+
+ModelConfig modelConfigFromYaml(const std::string& yaml_text, const std::string& origin) {
+  ModelConfig m;
+  readModel(MapReader(parse(yaml_text, origin), "model", origin), &m);
+  return m;
+}
+
+std::vector<std::string> diffModelConfigs(const ModelConfig& a, const ModelConfig& b) {
+  std::map<std::string, std::string> fa, fb;
+  flatten(YAML::Load(modelConfigToYaml(a)), "", &fa);
+  flatten(YAML::Load(modelConfigToYaml(b)), "", &fb);
+  std::vector<std::string> out;
+  for (const auto& [k, v] : fa) {
+    auto it = fb.find(k);
+    const std::string w = it == fb.end() ? "<absent>" : it->second;
+    if (v != w) out.push_back("model." + k + ": " + v + " vs " + w);
+  }
+  for (const auto& [k, w] : fb)
+    if (!fa.count(k)) out.push_back("model." + k + ": <absent> vs " + w);
+  return out;
+}
+
+}  // namespace ret3d

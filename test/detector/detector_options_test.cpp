@@ -1,0 +1,75 @@
+#include "ret3d/detector/detector_options.h"
+
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "test_util.h"
+
+namespace ret3d {
+namespace {
+
+TEST(DetectorOptions, ShippedConfigsLoadAndValidate) {
+  for (const char* name : {"lwd3d_center.yaml", "lwd3d_anchor.yaml"}) {
+    const auto o = loadDetectorOptions(std::string(RET3D_SOURCE_DIR) + "/config/detector/" + name);
+    EXPECT_EQ(o.model.classes.size(), 3u);
+    EXPECT_EQ(o.model.geometry.width(), 384);
+    EXPECT_EQ(o.inference.threads, 2);
+  }
+  EXPECT_EQ(loadDetectorOptions(std::string(RET3D_SOURCE_DIR) + "/config/detector/lwd3d_anchor.yaml").model.head,
+            HeadType::Anchor);
+}
+
+TEST(DetectorOptions, ValuesAreReadAndDefaultsKept) {
+  const auto o = detectorOptionsFromYaml(
+      "model:\n  head: anchor\n  bev: {resolution: 0.5, x_min: -32, x_max: 32}\n  network: {decoder_channels: 32}\n"
+      "inference: {score_threshold: 0.5}\ntrain: {epochs: 3}\n");
+  EXPECT_EQ(o.model.head, HeadType::Anchor);
+  EXPECT_DOUBLE_EQ(o.model.geometry.resolution, 0.5);
+  EXPECT_EQ(o.model.geometry.width(), 128);
+  EXPECT_EQ(o.model.geometry.height(), 192);  // y keeps its default extent
+  EXPECT_EQ(o.model.network.decoder_channels, 32);
+  EXPECT_FLOAT_EQ(o.inference.score_threshold, 0.5f);
+  EXPECT_EQ(o.train.epochs, 3);
+  EXPECT_EQ(o.train.batch_size, TrainOptions().batch_size);
+}
+
+TEST(DetectorOptions, MistakesAreRefusedNamingTheFileAndKey) {
+  test::TempDir dir;
+  const std::string path = dir / "bad.yaml";
+  std::ofstream(path) << "model:\n  bev:\n    resolutoin: 0.2\n";
+  try {
+    loadDetectorOptions(path);
+    FAIL() << "a typo was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("model.bev.resolutoin: unknown key"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(detectorOptionsFromYaml("model: {head: yolo}"), std::runtime_error);
+  EXPECT_THROW(detectorOptionsFromYaml("model: {classes: [Car, Truck]}"), std::runtime_error);
+  EXPECT_THROW(detectorOptionsFromYaml("model: {bev: {resolution: abc}}"), std::runtime_error);
+  // 96 m / 0.35 m is not a whole number of cells; 90 m / 0.25 m = 360 cells is not divisible by the stride 16.
+  EXPECT_THROW(detectorOptionsFromYaml("model: {bev: {resolution: 0.35}}"), std::runtime_error);
+  EXPECT_THROW(detectorOptionsFromYaml("model: {bev: {x_min: -45, x_max: 45}}"), std::runtime_error);
+  EXPECT_THROW(detectorOptionsFromYaml("model: {head: center, center: {stride: 2}}"), std::runtime_error);
+  EXPECT_THROW(detectorOptionsFromYaml("model: {bev: {x_min: 0, x_max: 0}}"), std::runtime_error);
+}
+
+TEST(DetectorOptions, ModelConfigRoundTripsAndDiffsReadably) {
+  ModelConfig m;
+  m.head = HeadType::Anchor;
+  m.geometry.resolution = 0.2;
+  m.geometry.x_min = -51.2, m.geometry.x_max = 51.2, m.geometry.y_min = -51.2, m.geometry.y_max = 51.2;
+  const ModelConfig back = modelConfigFromYaml(modelConfigToYaml(m), "test");
+  EXPECT_TRUE(diffModelConfigs(m, back).empty());
+  ModelConfig other = m;
+  other.geometry.resolution = 0.25;
+  other.classes = {ObjectClass::Car};
+  const auto d = diffModelConfigs(m, other);
+  ASSERT_EQ(d.size(), 2u);
+  EXPECT_EQ(d[0], "model.bev.resolution: 0.2 vs 0.25");
+  EXPECT_EQ(d[1], "model.classes: [Car, Pedestrian, Cyclist] vs [Car]");
+}
+
+}  // namespace
+}  // namespace ret3d

@@ -1,0 +1,134 @@
+#include "ret3d/detector/model_file.h"
+
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "ret3d/detector/detector.h"
+#include "ret3d/detector/nn/model.h"
+#include "test_util.h"
+
+namespace ret3d {
+namespace {
+
+ModelConfig smallModel(HeadType head) {
+  ModelConfig m;
+  m.geometry.x_min = -16, m.geometry.x_max = 16, m.geometry.y_min = -16, m.geometry.y_max = 16;
+  m.network.stage_blocks = {1, 1, 1};
+  m.network.decoder_channels = 32;
+  m.network.head_channels = 32;
+  m.head = head;
+  return m;
+}
+
+PointCloud someCloud(unsigned seed) {
+  PointCloud c;
+  std::uint32_t s = seed;
+  auto rnd = [&]() { s = s * 1664525u + 1013904223u; return (s >> 8) / 16777216.0f; };
+  for (int i = 0; i < 5000; ++i) c.push_back({rnd() * 32 - 16, rnd() * 32 - 16, rnd() * 3 - 2.5f, rnd()});
+  return c;
+}
+
+std::string readAll(const std::string& p) {
+  std::ifstream f(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(f), {});
+}
+
+void writeAll(const std::string& p, const std::string& s) { std::ofstream(p, std::ios::binary) << s; }
+
+class ModelFileTest : public ::testing::TestWithParam<HeadType> {};
+
+TEST_P(ModelFileTest, SaveThenLoadGivesIdenticalOutputs) {
+  test::TempDir dir;
+  torch::manual_seed(5);
+  DetectorOptions o;
+  o.model = smallModel(GetParam());
+  o.inference.score_threshold = 0.0f;  // an untrained net: keep candidates so boxes and features are compared
+  o.inference.max_detections = 50;
+  auto model = std::make_shared<nn::DetectorModel>(o.model);
+  // Move the BatchNorm statistics off their defaults so the buffers are part of what must survive.
+  model->net->train();
+  { torch::NoGradGuard ng; model->forward(torch::rand({2, 6, 128, 128})); }
+  model->net->eval();
+  const std::string path = dir / "m.ret3d";
+  model->save(path, "train: {epochs: 1}\n");
+
+  Detector a(o, model);
+  o.inference.model_path = path;
+  Detector b(o);
+  const PointCloud cur = someCloud(1), prev = someCloud(2);
+  const Eigen::Isometry3d T(Eigen::Translation3d(0.5, 0, 0));
+  const Detections da = a.detect(cur, &prev, T), db = b.detect(cur, &prev, T);
+  ASSERT_FALSE(da.boxes.empty());
+  ASSERT_EQ(da.boxes.size(), db.boxes.size());
+  for (std::size_t i = 0; i < da.boxes.size(); ++i) {
+    EXPECT_EQ(da.boxes[i].x, db.boxes[i].x);
+    EXPECT_EQ(da.boxes[i].yaw, db.boxes[i].yaw);
+    EXPECT_EQ(da.boxes[i].score, db.boxes[i].score);
+    EXPECT_EQ(da.boxes[i].label, db.boxes[i].label);
+  }
+  EXPECT_EQ(da.feature_dim, 32u);
+  EXPECT_EQ(da.features, db.features);
+  const ModelMetadata meta = readModelFile(path).metadata;
+  EXPECT_EQ(meta.feature_dim, 32);
+  EXPECT_EQ(meta.trained_with, "train: {epochs: 1}\n");
+  EXPECT_EQ(meta.anchors.size(), GetParam() == HeadType::Anchor ? 6u : 0u);
+  EXPECT_EQ(meta.parameter_count, b.parameterCount());
+}
+
+INSTANTIATE_TEST_SUITE_P(BothHeads, ModelFileTest, ::testing::Values(HeadType::Center, HeadType::Anchor));
+
+TEST(ModelFile, OtherMetadataIsRefusedSayingWhatDiffers) {
+  test::TempDir dir;
+  const std::string path = dir / "m.ret3d";
+  nn::DetectorModel(smallModel(HeadType::Center)).save(path);
+  DetectorOptions o;
+  o.model = smallModel(HeadType::Center);
+  o.model.geometry.resolution = 0.125;
+  o.model.classes = {ObjectClass::Car, ObjectClass::Pedestrian};
+  o.inference.model_path = path;
+  try {
+    Detector d(o);
+    FAIL() << "a model with other metadata was accepted";
+  } catch (const ModelFileError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("model.bev.resolution: 0.25 vs 0.125"), std::string::npos) << m;
+    EXPECT_NE(m.find("model.classes: [Car, Pedestrian, Cyclist] vs [Car, Pedestrian]"), std::string::npos) << m;
+  }
+  o.model = smallModel(HeadType::Anchor);
+  EXPECT_THROW(Detector{o}, ModelFileError);
+}
+
+TEST(ModelFile, TruncatedOrCorruptFilesAreRefused) {
+  test::TempDir dir;
+  const std::string path = dir / "m.ret3d";
+  nn::DetectorModel(smallModel(HeadType::Center)).save(path);
+  const std::string good = readAll(path);
+  ASSERT_NO_THROW(readModelFile(path));
+  auto expectRefused = [&](const std::string& bytes, const std::string& words) {
+    writeAll(path, bytes);
+    try {
+      readModelFile(path);
+      ADD_FAILURE() << "accepted: " << words;
+    } catch (const ModelFileError& e) {
+      EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    }
+  };
+  expectRefused(good.substr(0, good.size() / 2), "truncated");
+  expectRefused(good.substr(0, good.size() - 3), "truncated");
+  expectRefused(good.substr(0, 10), "truncated");
+  std::string flipped = good;
+  flipped[good.size() / 2] ^= 0x5a;
+  expectRefused(flipped, "checksum mismatch");
+  expectRefused("hello world, not a model", "not a ret3d model file");
+  std::string version = good;
+  version[8] = 9;
+  expectRefused(version, "format version 9");
+  expectRefused(good + "x", "unexpected bytes");
+  EXPECT_THROW(readModelFile(dir / "missing.ret3d"), ModelFileError);
+}
+
+}  // namespace
+}  // namespace ret3d
