@@ -4,7 +4,8 @@
 // The input boxes come from another detector's result files (--detections: KITTI object/tracking result files or
 // the per-class CSV layout); `--stages` lists what runs on them, in order: "intra" (IntraRM) or "none" (the boxes
 // pass through the same conversions, the fair baseline). The base detector stage ("base") runs on point clouds and
-// joins here when the detector is built.
+// joins here when the detector is built. "track" runs the tracker (CenterPoint's, real ego poses) and writes track ids;
+// "inter" runs the tracker and InterRM on every tracked box (train/inter_trainer.h: TrackingRefiner).
 #include <chrono>
 #include <filesystem>
 #include <iostream>
@@ -17,7 +18,10 @@
 #include "ret3d/eval/eval_data.h"
 #include "ret3d/io/detections.h"
 #include "ret3d/io/kitti.h"
+#include "ret3d/relation/inter_rm.h"
 #include "ret3d/relation/intra_rm.h"
+#include "ret3d/train/inter_trainer.h"
+#include "ret3d/tracking/tracker_options.h"
 #include "tools/command.h"
 
 namespace ret3d {
@@ -27,7 +31,7 @@ namespace {
 namespace fs = std::filesystem;
 
 struct DetectArgs {
-  std::string data, detections, out, stages = "intra", intra_model, sequences;
+  std::string data, detections, out, stages = "intra", intra_model, sequences, inter_model, tracker_config;
   int threads = 2;
 };
 
@@ -37,8 +41,8 @@ std::vector<std::string> splitStages(const std::string& s) {
   std::string item;
   while (std::getline(ss, item, ',')) {
     if (item.empty() || item == "none") continue;
-    if (item != "intra" && item != "base")
-      throw std::runtime_error("--stages: unknown stage '" + item + "' (known: base, intra, none)");
+    if (item != "intra" && item != "base" && item != "track" && item != "inter")
+      throw std::runtime_error("--stages: unknown stage '" + item + "' (known: base, intra, track, inter, none)");
     out.push_back(item);
   }
   return out;
@@ -47,6 +51,8 @@ std::vector<std::string> splitStages(const std::string& s) {
 // The stages after the base detector, applied to one frame.
 struct Stages {
   std::unique_ptr<relation::IntraRM> intra;
+  std::unique_ptr<relation::InterRM> inter;
+  std::unique_ptr<train::TrackingRefiner> tracking;  // stages track / inter: after the per-frame stages
   double seconds = 0;
   std::size_t frames = 0;
   Detections run(Detections d) {
@@ -69,8 +75,7 @@ std::vector<kitti::Label> toLabels(const Detections& d, const kitti::Calibration
   std::vector<kitti::Label> out;
   for (const Box& b : d.boxes) {
     kitti::Label l = kitti::boxToLabel(b, calib);
-    l.frame = frame;
-    l.track_id = -1;
+    l.frame = frame;  // track id: Box::track_id - 1 (boxToLabel), -1 when untracked
     out.push_back(l);
   }
   return out;
@@ -92,11 +97,25 @@ int runDetect(const DetectArgs& a) {
       o.threads = a.threads;
       st.intra = std::make_unique<relation::IntraRM>(o);
     }
+    if (s == "inter") {
+      if (a.inter_model.empty()) throw std::runtime_error("--stages inter needs --inter-model FILE");
+      relation::InterRMOptions o;
+      o.model_path = a.inter_model;
+      o.threads = a.threads;
+      st.inter = std::make_unique<relation::InterRM>(o);
+    }
+    if (s == "track" || s == "inter") {
+      if (stages.back() != s) throw std::runtime_error("--stages: '" + s + "' must be the last stage");
+      const TrackerOptions t = a.tracker_config.empty() ? TrackerOptions{} : loadTrackerOptions(a.tracker_config);
+      st.tracking = std::make_unique<train::TrackingRefiner>(t, st.inter.get());
+    }
   }
   if (a.data.empty() || a.out.empty()) throw std::runtime_error("--data and --out are required");
   fs::create_directories(a.out);
   const io::DetectionLayout layout = io::detectDetectionLayout(a.detections);
   std::size_t boxes = 0;
+  if (layout == io::DetectionLayout::KittiObject && st.tracking)
+    throw std::runtime_error("--stages track/inter need sequences: " + a.detections + " holds per-frame object results");
   if (layout == io::DetectionLayout::KittiObject) {
     kitti::ObjectDataset ds(a.data);
     const auto frames = ds.frames();
@@ -116,11 +135,32 @@ int runDetect(const DetectArgs& a) {
     for (const std::string& seq : seqs) {
       const kitti::Calibration calib = kitti::readCalibration(ds.calibPath(seq));
       std::vector<kitti::Label> out;
-      for (const auto& [frame, labels] : io::readSequenceDetections(a.detections, layout, seq)) {
-        const Detections d = st.run(toDetections(labels, calib));
-        boxes += d.size();
-        const auto l = toLabels(d, calib, frame);
-        out.insert(out.end(), l.begin(), l.end());
+      const auto dets = io::readSequenceDetections(a.detections, layout, seq);
+      if (st.tracking) {
+        // Every frame in order (frames without detections too: tracks coast), at 10 Hz, with the real ego poses.
+        const auto poses = ds.lidarPoses(seq);
+        if (poses.empty()) throw std::runtime_error("sequence " + seq + ": no ego poses (pose/ or oxts/) for tracking");
+        if (!dets.empty() && dets.rbegin()->first >= static_cast<int>(poses.size()))
+          throw std::runtime_error("sequence " + seq + ": detections in frame " +
+                                   std::to_string(dets.rbegin()->first) + " beyond its " +
+                                   std::to_string(poses.size()) + " poses");
+        st.tracking->reset();
+        for (int frame = 0; frame < static_cast<int>(poses.size()); ++frame) {
+          const auto it = dets.find(frame);
+          Detections d = st.run(it == dets.end() ? Detections{} : toDetections(it->second, calib));
+          d.boxes = st.tracking->update(d.boxes, 0.1 * frame, poses[static_cast<std::size_t>(frame)]);
+          d.features.clear(), d.feature_dim = 0;
+          boxes += d.size();
+          const auto l = toLabels(d, calib, frame);
+          out.insert(out.end(), l.begin(), l.end());
+        }
+      } else {
+        for (const auto& [frame, labels] : dets) {
+          const Detections d = st.run(toDetections(labels, calib));
+          boxes += d.size();
+          const auto l = toLabels(d, calib, frame);
+          out.insert(out.end(), l.begin(), l.end());
+        }
       }
       kitti::writeTrackingLabels(a.out + "/" + seq + ".txt", out);
       bar.tick();
@@ -129,6 +169,11 @@ int runDetect(const DetectArgs& a) {
   std::cout << "detect: " << st.frames << " frames, " << boxes << " boxes written to " << a.out;
   if (st.intra && st.frames > 0)
     std::cout << "; IntraRM " << 1000.0 * st.seconds / static_cast<double>(st.frames) << " ms per frame";
+  if (st.tracking && st.tracking->frames() > 0) {
+    const double n = static_cast<double>(st.tracking->frames());
+    std::cout << "; tracker " << 1000.0 * st.tracking->trackerSeconds() / n << " ms per frame";
+    if (st.inter) std::cout << ", InterRM " << 1000.0 * st.tracking->interSeconds() / n << " ms per frame";
+  }
   std::cout << std::endl;
   return 0;
 }
@@ -139,8 +184,11 @@ CommandRegistrar reg("detect", "run detection stages offline (IntraRM on another
   app.add_option("--data", a->data, "KITTI tracking or object root (calibration)");
   app.add_option("--detections", a->detections,
                  "input boxes: KITTI object/tracking result files or per-class CSV folders");
-  app.add_option("--stages", a->stages, "comma-separated stages to run: intra, none")->capture_default_str();
+  app.add_option("--stages", a->stages, "comma-separated stages to run: intra, track, inter, none")->capture_default_str();
   app.add_option("--intra-model", a->intra_model, "IntraRM model file (for the intra stage)");
+  app.add_option("--inter-model", a->inter_model, "InterRM model file (for the inter stage)");
+  app.add_option("--tracker-config", a->tracker_config, "tracker YAML for track/inter (default: config/tracker.yaml's "
+                 "values, built in)");
   app.add_option("--sequences", a->sequences, "tracking sequences, e.g. 16-20 (default: all)");
   app.add_option("--out", a->out, "output folder for KITTI result files");
   app.add_option("--threads", a->threads, "CPU threads for libtorch")->capture_default_str();

@@ -1,0 +1,83 @@
+// InterRM (Ret3D §3.3) on tracked sequences: the glue between the tracker's histories and InterRM (used by training,
+// `ret3d detect --stages ...,inter` and the benchmarks), building training sequences by running the tracker over
+// another detector's boxes with the real ego poses (optionally IntraRM first), and the epoch loop with checkpoints.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "ret3d/relation/inter_rm.h"
+#include "ret3d/relation/inter_rm_learner.h"
+#include "ret3d/tracking/greedy_tracker.h"
+
+namespace ret3d {
+namespace train {
+
+// A tracker history (oldest first, the last entry the current box) as an InterRM sequence (newest first). When
+// `current` is given, it replaces the newest entry (the tracked box as output, exactly).
+relation::InterRMSequence toInterRMSequence(const std::vector<TimedBox>& history, const Box* current = nullptr);
+
+// The tracker followed by InterRM, one frame at a time: what runs online after the detector (and IntraRM).
+class TrackingRefiner {
+ public:
+  // `inter` may be null: tracking only. The refiner does not own it.
+  TrackingRefiner(const TrackerOptions& tracker, const relation::InterRM* inter);
+  // Tracks the frame's detections (sensor frame, at `stamp`, sensor pose in the fixed frame) and refines every tracked
+  // box from its history. Returns the tracked boxes with track ids (sensor frame).
+  std::vector<Box> update(const std::vector<Box>& detections, double stamp, const Eigen::Isometry3d& sensor_to_fixed);
+  // A new sequence: forget the tracks (ids keep counting).
+  void reset() { tracker_.reset(); }
+  const GreedyTracker& tracker() const { return tracker_; }
+
+  double trackerSeconds() const { return tracker_s_; }
+  double interSeconds() const { return inter_s_; }
+  std::size_t frames() const { return frames_; }
+
+ private:
+  GreedyTracker tracker_;
+  const relation::InterRM* inter_;
+  double tracker_s_ = 0, inter_s_ = 0;
+  std::size_t frames_ = 0;
+};
+
+struct InterDataOptions {
+  std::string data_dir;        // KITTI tracking root (label_02, calib, pose or oxts)
+  std::string detections_dir;  // detector outputs (KITTI tracking result files or the per-class CSV layout)
+  std::vector<std::string> sequences;  // empty = every sequence with labels
+  std::string intra_model;     // optional IntraRM model run on each frame before tracking
+  TrackerOptions tracker;
+  double frame_period = 0.1;   // s between frames (KITTI: 10 Hz)
+};
+
+// One sample per tracked box whose class-aware best BEV IoU with a ground-truth box reaches reg_min_iou of its class
+// (the assignment IntraRM uses); the target is that ground-truth box. Throws std::runtime_error naming what is
+// missing (labels, poses, a detection layout without sequences).
+std::vector<relation::InterRMSample> loadInterSamples(const InterDataOptions& data,
+                                                      const relation::InterRMTrainConfig& config);
+
+struct InterTrainOptions {
+  relation::InterRMConfig config;
+  std::string out_path;        // the model file (best validation epoch, or the last one without validation)
+  std::string checkpoint_dir;  // default: out_path + ".ckpt"
+  bool resume = false;
+  std::string trained_on;
+  bool progress = true;
+};
+
+struct InterTrainReport {
+  int epochs_run = 0, best_epoch = -1;
+  double first_train_loss = 0, last_train_loss = 0, best_val_loss = 0;
+  double initial_val_loss = 0;  // validation loss of the untrained (identity) module = the input boxes' error
+  std::vector<double> val_losses;
+  double seconds = 0;
+  std::size_t train_sequences = 0, val_sequences = 0;
+};
+
+InterTrainReport trainInterRM(const std::vector<relation::InterRMSample>& train,
+                              const std::vector<relation::InterRMSample>& val, const InterTrainOptions& options);
+
+}  // namespace train
+}  // namespace ret3d

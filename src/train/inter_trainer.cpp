@@ -1,0 +1,224 @@
+#include "ret3d/train/inter_trainer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <numeric>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+
+#include "ret3d/core/log.h"
+#include "ret3d/core/progress.h"
+#include "ret3d/io/detections.h"
+#include "ret3d/io/kitti.h"
+#include "ret3d/relation/intra_rm.h"
+#include "ret3d/relation/intra_rm_targets.h"
+
+namespace ret3d {
+namespace train {
+
+using relation::InterRMSample;
+using relation::InterRMSequence;
+
+InterRMSequence toInterRMSequence(const std::vector<TimedBox>& history, const Box* current) {
+  InterRMSequence s;
+  s.boxes.reserve(history.size() + (history.empty() ? 1 : 0));
+  s.dt.reserve(s.boxes.capacity());
+  for (auto it = history.rbegin(); it != history.rend(); ++it) {
+    s.boxes.push_back(it->box);
+    s.dt.push_back(it->dt);
+  }
+  if (current) {
+    if (s.boxes.empty()) {
+      s.boxes.push_back(*current);
+      s.dt.push_back(0.0);
+    } else {
+      s.boxes[0] = *current;
+    }
+  }
+  return s;
+}
+
+TrackingRefiner::TrackingRefiner(const TrackerOptions& tracker, const relation::InterRM* inter)
+    : tracker_(tracker), inter_(inter) {}
+
+std::vector<Box> TrackingRefiner::update(const std::vector<Box>& detections, double stamp,
+                                         const Eigen::Isometry3d& sensor_to_fixed) {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<Box> tracked = tracker_.update(detections, stamp, sensor_to_fixed);
+  const auto t1 = std::chrono::steady_clock::now();
+  if (inter_ && !tracked.empty()) {
+    std::vector<InterRMSequence> seqs;
+    seqs.reserve(tracked.size());
+    for (const Box& b : tracked) seqs.push_back(toInterRMSequence(tracker_.history(b.track_id), &b));
+    tracked = inter_->refine(seqs);
+  }
+  const auto t2 = std::chrono::steady_clock::now();
+  tracker_s_ += std::chrono::duration<double>(t1 - t0).count();
+  inter_s_ += std::chrono::duration<double>(t2 - t1).count();
+  ++frames_;
+  return tracked;
+}
+
+std::vector<InterRMSample> loadInterSamples(const InterDataOptions& data, const relation::InterRMTrainConfig& config) {
+  namespace fs = std::filesystem;
+  const io::DetectionLayout layout = io::detectDetectionLayout(data.detections_dir);
+  if (layout == io::DetectionLayout::KittiObject)
+    throw std::runtime_error("detections " + data.detections_dir +
+                             " are per-frame object result files; InterRM needs sequences (tracking result files or "
+                             "per-class CSV folders)");
+  kitti::TrackingDataset ds(data.data_dir);
+  std::vector<std::string> seqs = data.sequences;
+  if (seqs.empty())
+    for (const std::string& s : ds.sequences())
+      if (ds.hasLabels(s)) seqs.push_back(s);
+  std::unique_ptr<relation::IntraRM> intra;
+  if (!data.intra_model.empty()) {
+    relation::IntraRMOptions o;
+    o.model_path = data.intra_model;
+    intra = std::make_unique<relation::IntraRM>(o);
+  }
+  // Targets as IntraRM assigns them (class-aware best BEV IoU, regressed from reg_min_iou).
+  relation::IntraRMTrainConfig assign;
+  assign.reg_min_iou = config.reg_min_iou;
+  assign.cls_pos_iou = config.reg_min_iou;
+
+  std::vector<InterRMSample> samples;
+  for (const std::string& seq : seqs) {
+    if (!ds.hasLabels(seq)) throw std::runtime_error("sequence " + seq + ": no labels in " + ds.dir());
+    const auto poses = ds.lidarPoses(seq);
+    if (poses.empty())
+      throw std::runtime_error("sequence " + seq + ": no ego poses (" + ds.posePath(seq) + " or " + ds.oxtsPath(seq) +
+                               ") - the tracker needs them");
+    const kitti::Calibration calib = kitti::readCalibration(ds.calibPath(seq));
+    std::map<int, relation::FrameGroundTruth> gt;
+    for (const kitti::Label& l : kitti::readTrackingLabels(ds.labelPath(seq)))
+      if (classFromName(l.type)) gt[l.frame].boxes.push_back(kitti::labelToBox(l, calib));
+    const auto dets = io::readSequenceDetections(data.detections_dir, layout, seq);
+    int last = static_cast<int>(poses.size()) - 1;
+    if (!dets.empty() && dets.rbegin()->first > last)
+      throw std::runtime_error("sequence " + seq + ": detections up to frame " + std::to_string(dets.rbegin()->first) +
+                               " but only " + std::to_string(poses.size()) + " poses");
+    GreedyTracker tracker(data.tracker);
+    for (int f = 0; f <= last; ++f) {
+      Detections d;
+      if (auto it = dets.find(f); it != dets.end())
+        for (const kitti::Label& l : it->second)
+          if (classFromName(l.type)) d.boxes.push_back(kitti::labelToBox(l, calib));
+      if (intra && !d.empty()) d = intra->refine(d);
+      const std::vector<Box> tracked =
+          tracker.update(d.boxes, f * data.frame_period, poses[static_cast<std::size_t>(f)]);
+      if (tracked.empty()) continue;
+      const auto g = gt.find(f);
+      if (g == gt.end()) continue;
+      const auto targets = relation::assignIntraRMTargets(tracked, g->second, assign);
+      for (std::size_t i = 0; i < tracked.size(); ++i) {
+        const relation::IntraRMTarget& t = targets[i];
+        if (!t.regress) continue;
+        InterRMSample s;
+        s.sequence = toInterRMSequence(tracker.history(tracked[i].track_id), &tracked[i]);
+        Box target = tracked[i];
+        target.x += t.dx, target.y += t.dy, target.z += t.dz;
+        target.length *= std::exp(t.dl), target.width *= std::exp(t.dw), target.height *= std::exp(t.dh);
+        target.yaw += t.dyaw;
+        s.target = target;
+        samples.push_back(std::move(s));
+      }
+    }
+  }
+  return samples;
+}
+
+InterTrainReport trainInterRM(const std::vector<InterRMSample>& train, const std::vector<InterRMSample>& val,
+                              const InterTrainOptions& options) {
+  if (train.empty()) throw std::runtime_error("InterRM training: no training sequences");
+  if (options.out_path.empty()) throw std::runtime_error("InterRM training: no output model path");
+  const relation::InterRMConfig& cfg = options.config;
+  const std::string ckpt = options.checkpoint_dir.empty() ? options.out_path + ".ckpt" : options.checkpoint_dir;
+  InterTrainReport report;
+  report.train_sequences = train.size();
+  report.val_sequences = val.size();
+
+  relation::InterRMLearner learner(cfg, cfg.train.seed);
+  learner.setTrainedOn(options.trained_on);
+  int start_epoch = 0;
+  double best_val = std::numeric_limits<double>::infinity();
+  if (options.resume && learner.loadCheckpoint(ckpt, &start_epoch, &best_val)) {
+    RET3D_INFO("InterRM: resuming from " << ckpt << " after epoch " << start_epoch);
+    learner.setTrainedOn(options.trained_on);
+  } else {
+    learner.fitNormalisation(train);
+  }
+  if (!val.empty() && start_epoch == 0) {
+    // The untrained module is the identity: its loss is that of the input boxes, the bar to beat.
+    report.initial_val_loss = learner.evaluate(val).total;
+    best_val = report.initial_val_loss;
+    // Written now, so that if no epoch beats the input boxes the model file is the identity, never a worse module.
+    learner.model().save(options.out_path);
+    report.best_epoch = 0;
+    RET3D_INFO("InterRM: validation loss of the input boxes (identity) " << report.initial_val_loss);
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::size_t bs = static_cast<std::size_t>(cfg.train.sequences_per_batch);
+  const std::size_t batches = (train.size() + bs - 1) / bs;
+  for (int epoch = start_epoch; epoch < cfg.train.epochs; ++epoch) {
+    // The shuffle depends only on the seed and the epoch, so a resumed run sees the same order.
+    std::vector<std::size_t> order(train.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::mt19937_64 rng(cfg.train.seed * 1000003ULL + static_cast<std::uint64_t>(epoch));
+    std::shuffle(order.begin(), order.end(), rng);
+    double sum = 0;
+    std::unique_ptr<ProgressBar> bar;
+    if (options.progress)
+      bar = std::make_unique<ProgressBar>(
+          "InterRM epoch " + std::to_string(epoch + 1) + "/" + std::to_string(cfg.train.epochs), batches);
+    for (std::size_t b = 0; b < batches; ++b) {
+      std::vector<const InterRMSample*> batch;
+      for (std::size_t k = b * bs; k < std::min(train.size(), (b + 1) * bs); ++k) batch.push_back(&train[order[k]]);
+      const relation::InterRMLoss L = learner.step(batch);
+      if (epoch == start_epoch && b == 0) report.first_train_loss = L.total;
+      sum += L.total;
+      if (bar) {
+        std::ostringstream info;
+        info.precision(4);
+        info << "loss " << L.total << " (loc " << L.loc << " size " << L.size << " yaw " << L.yaw << ")";
+        bar->tick(1, info.str());
+      }
+    }
+    if (bar) bar->finish();
+    report.last_train_loss = sum / static_cast<double>(batches);
+    std::ostringstream msg;
+    msg << "InterRM epoch " << epoch + 1 << ": train loss " << report.last_train_loss;
+    if (!val.empty()) {
+      const relation::InterRMLoss V = learner.evaluate(val);
+      report.val_losses.push_back(V.total);
+      msg << ", validation loss " << V.total << " (loc " << V.loc << " size " << V.size << " yaw " << V.yaw << ")";
+      if (V.total < best_val) {
+        best_val = V.total;
+        report.best_epoch = epoch + 1;
+        learner.model().save(options.out_path);
+        msg << " - best, saved";
+      }
+    }
+    RET3D_INFO(msg.str());
+    learner.saveCheckpoint(ckpt, epoch + 1, best_val);
+    report.epochs_run = epoch + 1;
+  }
+  if (val.empty()) {
+    learner.model().save(options.out_path);
+    report.best_epoch = report.epochs_run;
+  } else if (report.best_epoch == 0) {
+    RET3D_WARN("InterRM: no epoch improved on the input boxes' validation loss; " << options.out_path
+                                                                                  << " is the identity module");
+  }
+  report.best_val_loss = best_val;
+  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return report;
+}
+
+}  // namespace train
+}  // namespace ret3d
