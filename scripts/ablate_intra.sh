@@ -14,7 +14,7 @@ SHARED="${RET3D_SHARED_DATA:-$ROOT/../shared/data}"
 DATA="$SHARED/kitti_tracking"
 DETS="$DATA/detections/pointrcnn"
 OUT="$ROOT/out/ablate_intra"
-CONFIGS="${CONFIGS:-intra_rm intra_no_edge intra_r1 intra_r4 intra_m1 intra_m2 intra_m6}"
+CONFIGS="${CONFIGS:-intra_rm intra_boxes intra_no_edge intra_r1 intra_r4 intra_m1 intra_m2 intra_m6}"
 TRAIN_SEQ="${TRAIN_SEQ:-1-15}"
 TEST_SEQ="${TEST_SEQ:-16-20}"
 THREADS="${THREADS:-2}"
@@ -28,10 +28,7 @@ ap_row() {  # name report_dir extra_cells
 import json, sys
 name, path, extra = sys.argv[1], sys.argv[2], sys.argv[3]
 m = json.load(open(path))
-aps = []
-for cls in ("Car", "Pedestrian", "Cyclist"):
-    c = next(c for c in m["kitti"]["classes"] if c["class"] == cls)
-    aps.append(c["3d"]["moderate"]["ap40"])
+aps = [m["kitti.%s.3d.R40.moderate" % cls] for cls in ("Car", "Pedestrian", "Cyclist")]
 print("| %s | %.2f | %.2f | %.2f | %.2f | %s |" % (name, aps[0], aps[1], aps[2], sum(aps) / 3, extra))
 PY
 }

@@ -77,7 +77,7 @@ Detections IntraRM::refine(const Detections& input) const {
   torch::InferenceMode guard;
   const IntraRMInputs in = makeIntraRMInputs({src}, a);
   const IntraRMOutput out = impl_->net->forward(in.basic, in.feat, in.source, in.target);
-  return applyIntraRMOutput(input, out);
+  return applyIntraRMOutput(input, out, a.refine_boxes);
 }
 
 }  // namespace relation

@@ -96,13 +96,15 @@ IntraRMConfig parseIntraRMConfig(const std::string& yaml_text, const std::string
   if (root.IsNull()) return c;
   checkKeys(root, {"model", "train"}, source, "<top>");
   if (const YAML::Node m = root["model"]) {
-    checkKeys(m, {"feature_dim", "hidden", "rounds", "radius", "use_edges", "head_hidden"}, source, "model");
+    checkKeys(m, {"feature_dim", "hidden", "rounds", "radius", "use_edges", "head_hidden", "refine_boxes"}, source,
+              "model");
     read(m, "feature_dim", &c.model.feature_dim, source, "model");
     read(m, "hidden", &c.model.hidden, source, "model");
     read(m, "rounds", &c.model.rounds, source, "model");
     read(m, "radius", &c.model.radius, source, "model");
     read(m, "use_edges", &c.model.use_edges, source, "model");
     read(m, "head_hidden", &c.model.head_hidden, source, "model");
+    read(m, "refine_boxes", &c.model.refine_boxes, source, "model");
   }
   if (const YAML::Node t = root["train"]) {
     checkKeys(t,
@@ -150,6 +152,7 @@ std::string toYaml(const IntraRMConfig& c) {
   e << YAML::Key << "radius" << YAML::Value << c.model.radius;
   e << YAML::Key << "use_edges" << YAML::Value << c.model.use_edges;
   e << YAML::Key << "head_hidden" << YAML::Value << c.model.head_hidden;
+  e << YAML::Key << "refine_boxes" << YAML::Value << c.model.refine_boxes;
   e << YAML::EndMap;
   auto per_class = [&](const char* key, const PerClass& v) {
     e << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginMap;

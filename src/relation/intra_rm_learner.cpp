@@ -71,13 +71,17 @@ struct IntraRMLearner::Impl {
     // Smooth-L1 on location (centre and log size: the box's place and extent) and on heading, over regressed boxes.
     const double n_reg = std::max(1.0, reg_m.sum().item<double>());
     const torch::Tensor m = reg_m.unsqueeze(1);
-    const torch::Tensor pred_reg = torch::cat({out.loc, out.box.slice(1, 1, 4)}, 1);
-    const torch::Tensor t_reg = torch::cat({loc_t, box_t.slice(1, 1, 4)}, 1);
+    // Both sides in the units of the residuals' spread (IntraRMNetImpl::loc_scale, box_scale).
+    const torch::Tensor ls = net()->loc_scale, bs = net()->box_scale;
+    const torch::Tensor pred_reg = torch::cat({out.loc / ls, (out.box / bs).slice(1, 1, 4)}, 1);
+    const torch::Tensor t_reg = torch::cat({loc_t / ls, (box_t / bs).slice(1, 1, 4)}, 1);
     const torch::Tensor l_reg =
         (torch::smooth_l1_loss(pred_reg, t_reg, at::Reduction::None) * m).sum() / n_reg;
-    const torch::Tensor l_dir =
-        (torch::smooth_l1_loss(out.box.slice(1, 0, 1), box_t.slice(1, 0, 1), at::Reduction::None) * m).sum() /
-        n_reg;
+    const torch::Tensor l_dir = (torch::smooth_l1_loss((out.box / bs).slice(1, 0, 1), (box_t / bs).slice(1, 0, 1),
+                                                       at::Reduction::None) *
+                                 m)
+                                    .sum() /
+                                n_reg;
     const torch::Tensor total = l_cls + config.train.loc_weight * l_reg + config.train.dir_weight * l_dir;
     IntraRMLoss L;
     L.total = total.item<double>();
@@ -136,6 +140,23 @@ void IntraRMLearner::fitNormalisation(const std::vector<IntraRMFrame>& frames) {
   for (int k : {6, 7, 11, 12, 13}) keep[static_cast<std::size_t>(k)] = false;
   stats(sum, sq, net->basic_mean, net->basic_std, keep);
   stats(fsum, fsq, net->feat_mean, net->feat_std, {});
+  // Spread (root mean square) of the regression targets.
+  double rs[7] = {0, 0, 0, 0, 0, 0, 0}, nr = 0;
+  for (const IntraRMFrame& fr : frames) {
+    for (const IntraRMTarget& t : fr.targets) {
+      if (!t.regress) continue;
+      const double v[7] = {t.dx, t.dy, t.dz, t.dyaw, t.dl, t.dw, t.dh};
+      for (int k = 0; k < 7; ++k) rs[k] += v[k] * v[k];
+      ++nr;
+    }
+  }
+  if (nr >= 2) {
+    for (int k = 0; k < 7; ++k) {
+      const double r = std::max(1e-3, std::sqrt(rs[k] / nr));
+      if (k < 3) net->loc_scale[k] = r;
+      else net->box_scale[k - 3] = r;
+    }
+  }
 }
 
 IntraRMLoss IntraRMLearner::step(const std::vector<const IntraRMFrame*>& batch) {

@@ -23,6 +23,8 @@ IntraRMNetImpl::IntraRMNetImpl(const IntraRMArch& a) : arch(a) {
   basic_std = register_buffer("basic_std", torch::ones({kIntraBasicFeatures}));
   feat_mean = register_buffer("feat_mean", torch::zeros({f}));
   feat_std = register_buffer("feat_std", torch::ones({f}));
+  loc_scale = register_buffer("loc_scale", torch::ones({3}));
+  box_scale = register_buffer("box_scale", torch::ones({4}));
   embed = register_module("embed", nn::Linear(kIntraBasicFeatures + f, arch.hidden));
   // H of eq. (2): EdgeConv's shared MLP on [x_j - x_i, x_i] (two layers; ReLU keeps the max of eq. (3) meaningful).
   for (int k = 0; k < arch.rounds; ++k) {
@@ -37,10 +39,11 @@ IntraRMNetImpl::IntraRMNetImpl(const IntraRMArch& a) : arch(a) {
   head_loc = register_module("head_loc", nn::Linear(arch.head_hidden, 3));
   head_box = register_module("head_box", nn::Linear(arch.head_hidden, 4));
   head_cls = register_module("head_cls", nn::Linear(arch.head_hidden, kIntraNumClasses));
-  // Residual heads start at zero, so an untrained module returns the input boxes unchanged and training starts from
-  // the base detector's boxes rather than from noise.
+  score_gain = register_parameter("score_gain", torch::ones({kIntraNumClasses}));
+  // The heads start at zero, so an untrained module returns the input boxes unchanged and ranks them as the base
+  // detector did (its score through a sigmoid); training starts from the base detector rather than from noise.
   torch::NoGradGuard no_grad;
-  for (auto* l : {&head_loc, &head_box}) {
+  for (auto* l : {&head_loc, &head_box, &head_cls}) {
     (*l)->weight.zero_();
     (*l)->bias.zero_();
   }
@@ -65,7 +68,9 @@ IntraRMOutput IntraRMNetImpl::forward(const torch::Tensor& basic, const torch::T
     rounds.push_back(x);
   }
   const torch::Tensor h = head_trunk->forward(torch::cat(rounds, 1));  // eq. (4)
-  return {head_loc->forward(h), head_box->forward(h), head_cls->forward(h)};
+  const torch::Tensor score = in.slice(1, 10, 11);  // the normalised input score
+  return {head_loc->forward(h) * loc_scale, head_box->forward(h) * box_scale,
+          head_cls->forward(h) + score * score_gain};
 }
 
 void basicFeatures(const Box& b, float* o) {
@@ -115,7 +120,7 @@ IntraRMInputs makeIntraRMInputs(const std::vector<const Detections*>& frames, co
   return in;
 }
 
-Detections applyIntraRMOutput(const Detections& input, const IntraRMOutput& out) {
+Detections applyIntraRMOutput(const Detections& input, const IntraRMOutput& out, bool refine_boxes) {
   Detections result = input;
   if (input.empty()) return result;
   const torch::Tensor loc = out.loc.to(torch::kDouble).contiguous();
@@ -126,13 +131,15 @@ Detections applyIntraRMOutput(const Detections& input, const IntraRMOutput& out)
   const float* pc = prob.data_ptr<float>();
   for (std::size_t i = 0; i < result.size(); ++i) {
     Box& b = result.boxes[i];
-    b.x += pl[3 * i];
-    b.y += pl[3 * i + 1];
-    b.z += pl[3 * i + 2];
-    b.yaw = wrapAngle(b.yaw + pb[4 * i]);
-    b.length *= std::exp(pb[4 * i + 1]);
-    b.width *= std::exp(pb[4 * i + 2]);
-    b.height *= std::exp(pb[4 * i + 3]);
+    if (refine_boxes) {
+      b.x += pl[3 * i];
+      b.y += pl[3 * i + 1];
+      b.z += pl[3 * i + 2];
+      b.yaw = wrapAngle(b.yaw + pb[4 * i]);
+      b.length *= std::exp(pb[4 * i + 1]);
+      b.width *= std::exp(pb[4 * i + 2]);
+      b.height *= std::exp(pb[4 * i + 3]);
+    }
     const int c = classIndex(b.label);
     if (c >= 0) {
       b.score = pc[3 * i + c];

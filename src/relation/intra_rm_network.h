@@ -37,10 +37,17 @@ class IntraRMNetImpl : public torch::nn::Module {
   IntraRMArch arch;
   // Input normalisation (buffers, saved with the weights): x_norm = (x - mean) / std.
   torch::Tensor basic_mean, basic_std, feat_mean, feat_std;
+  // Scale of the regression outputs (centre x y z, heading, log size l w h): the spread of the residuals in the
+  // training data. The heads predict residuals in these units, so the loss sees errors of order one rather than
+  // centimetres (a well-placed detector's residuals are a few centimetres, too small for smooth-L1 to learn from).
+  torch::Tensor loc_scale, box_scale;
   torch::nn::Linear embed{nullptr};                 // W^x of eq. (1)
   std::vector<torch::nn::Sequential> edge_mlps;     // H of eq. (2), one per round
   torch::nn::Sequential head_trunk{nullptr};
   torch::nn::Linear head_loc{nullptr}, head_box{nullptr}, head_cls{nullptr};
+  // Per-class gain on the normalised input score, added to the class logits: the classification is a residual on
+  // the base detector's own ranking, as the box outputs are residuals on its boxes.
+  torch::Tensor score_gain;
 };
 TORCH_MODULE(IntraRMNet);
 
@@ -56,8 +63,8 @@ struct IntraRMInputs {
 };
 IntraRMInputs makeIntraRMInputs(const std::vector<const Detections*>& frames, const IntraRMArch& arch);
 
-// Applies the predicted residuals and scores to the input boxes.
-Detections applyIntraRMOutput(const Detections& input, const IntraRMOutput& out);
+// Applies the predicted scores and (when refine_boxes) residuals to the input boxes.
+Detections applyIntraRMOutput(const Detections& input, const IntraRMOutput& out, bool refine_boxes = true);
 
 // Model file: a torch archive holding the parameters and buffers plus a YAML metadata string.
 void saveIntraRMModel(const std::string& path, const IntraRM::Impl& impl);

@@ -1,6 +1,7 @@
 #include "ret3d/relation/intra_rm_targets.h"
 
 #include <cmath>
+#include <utility>
 
 #include "ret3d/core/geometry.h"
 
@@ -76,10 +77,18 @@ std::vector<IntraRMTarget> assignIntraRMTargets(const std::vector<Box>& detectio
       t.dx = static_cast<float>(g.x - d.x);
       t.dy = static_cast<float>(g.y - d.y);
       t.dz = static_cast<float>(g.z - d.z);
-      t.dl = static_cast<float>(std::log(std::max(g.length, 1e-3) / std::max(d.length, 1e-3)));
-      t.dw = static_cast<float>(std::log(std::max(g.width, 1e-3) / std::max(d.width, 1e-3)));
+      // A rectangle turned by 90 degrees with length and width swapped is the same rectangle: take the description
+      // of the ground truth closest to the detection's heading, so a near-square box (a pedestrian) whose heading
+      // is a quarter turn off gets consistent size targets instead of swapped ones.
+      double dyaw = headingResidual(d.yaw, g.yaw), gl = g.length, gw = g.width;
+      if (std::abs(dyaw) > M_PI / 4) {
+        std::swap(gl, gw);
+        dyaw -= std::copysign(M_PI / 2, dyaw);
+      }
+      t.dl = static_cast<float>(std::log(std::max(gl, 1e-3) / std::max(d.length, 1e-3)));
+      t.dw = static_cast<float>(std::log(std::max(gw, 1e-3) / std::max(d.width, 1e-3)));
       t.dh = static_cast<float>(std::log(std::max(g.height, 1e-3) / std::max(d.height, 1e-3)));
-      t.dyaw = headingResidual(d.yaw, g.yaw);
+      t.dyaw = static_cast<float>(dyaw);
     }
   }
   return out;

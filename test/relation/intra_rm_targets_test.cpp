@@ -63,6 +63,20 @@ TEST(IntraRMTargets, SizeResidualsAreLogRatios) {
   EXPECT_NEAR(t[0].dw, 0, 1e-6);
 }
 
+TEST(IntraRMTargets, AQuarterTurnIsTakenAsSwappedLengthAndWidth) {
+  FrameGroundTruth gt;
+  Box g = car(0, 0, M_PI / 2 + 0.05);
+  g.label = ObjectClass::Pedestrian, g.length = 0.8, g.width = 0.6;
+  gt.boxes = {g};
+  Box d = g;
+  d.yaw = 0, d.length = 0.6, d.width = 0.8;  // the same rectangle, described a quarter turn away
+  const auto t = assignIntraRMTargets({d}, gt, IntraRMTrainConfig{});
+  ASSERT_TRUE(t[0].regress);
+  EXPECT_NEAR(t[0].dyaw, 0.05, 1e-6);
+  EXPECT_NEAR(t[0].dl, 0, 1e-6);
+  EXPECT_NEAR(t[0].dw, 0, 1e-6);
+}
+
 }  // namespace
 }  // namespace relation
 }  // namespace ret3d

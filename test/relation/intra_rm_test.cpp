@@ -153,6 +153,46 @@ TEST(IntraRM, ModelTrainedWithFeaturesRefusesFeaturelessInput) {
   EXPECT_EQ(r1.feature_dim, 3u);
 }
 
+TEST(IntraRM, ScoreOnlyModelKeepsTheBoxGeometry) {
+  // Two identical trainings (same seed and data), one with refine_boxes off: same scores, boxes untouched.
+  auto train = [](bool refine_boxes) {
+    IntraRMConfig c;
+    c.model.hidden = 16;
+    c.model.head_hidden = 16;
+    c.model.refine_boxes = refine_boxes;
+    c.train.lr = 1e-2;
+    IntraRMLearner learner(c, 5);
+    std::mt19937 rng(11);
+    std::vector<IntraRMFrame> frames;
+    for (int i = 0; i < 8; ++i) frames.push_back(test::randomFrame(rng, 12));
+    learner.fitNormalisation(frames);
+    std::vector<const IntraRMFrame*> batch;
+    for (const auto& f : frames) batch.push_back(&f);
+    for (int i = 0; i < 5; ++i) learner.step(batch);
+    return learner.snapshot();
+  };
+  const IntraRM full = train(true), score_only = train(false);
+  ret3d::test::TempDir tmp;
+  score_only.save(tmp / "m.pt");
+  IntraRMOptions o;
+  o.model_path = tmp / "m.pt";
+  const IntraRM loaded(o);
+  EXPECT_FALSE(loaded.arch().refine_boxes);
+  std::mt19937 rng(31);
+  const Detections in = test::randomFrame(rng, 20).detections;
+  const Detections a = full.refine(in), b = loaded.refine(in);
+  bool moved = false;
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    moved |= a.boxes[i].x != in.boxes[i].x;
+    EXPECT_EQ(b.boxes[i].x, in.boxes[i].x);
+    EXPECT_EQ(b.boxes[i].yaw, in.boxes[i].yaw);
+    EXPECT_EQ(b.boxes[i].length, in.boxes[i].length);
+    EXPECT_NEAR(b.boxes[i].score, a.boxes[i].score, 1e-6);
+    EXPECT_NE(b.boxes[i].score, in.boxes[i].score);
+  }
+  EXPECT_TRUE(moved);
+}
+
 TEST(IntraRM, RejectsInconsistentInput) {
   Detections d;
   d.boxes.resize(2);

@@ -18,6 +18,10 @@ struct IntraRMArch {
   double radius = 2.0;          // r, metres: objects closer than this (BEV centres) are linked
   bool use_edges = true;        // false: self-loops only, each object refined alone (no-edge ablation)
   int head_hidden = 128;        // width of the head's hidden layer
+  // false: refine() keeps the input box geometry and refines the class scores only (the regression heads are still
+  // trained, eq. (5) unchanged). For a detector whose boxes come from its points (PointRCNN), box-level context
+  // alone does not locate a box better than the detector did (docs/RESULTS.md, IntraRM).
+  bool refine_boxes = true;
 
   void validate() const;  // throws std::invalid_argument naming the field
 };

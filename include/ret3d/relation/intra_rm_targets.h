@@ -27,7 +27,8 @@ struct IntraRMTarget {
   bool regress = false;
   float dx = 0, dy = 0, dz = 0;         // ground-truth centre minus detection centre (m)
   float dl = 0, dw = 0, dh = 0;         // log(ground-truth size / detection size)
-  float dyaw = 0;                       // heading residual wrapped to [-pi/2, pi/2) (KITTI IoU ignores direction)
+  float dyaw = 0;                       // heading residual in [-pi/4, pi/4]: direction is ignored (as KITTI's IoU),
+                                        // and a quarter turn is taken as swapped length and width
   float iou = 0;                        // best class-aware BEV IoU
 };
 
