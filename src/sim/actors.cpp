@@ -115,13 +115,21 @@ static void advancePhase(Actor& a, double v, double dt) {
   if (a.kind == ActorKind::Cyclist) a.phase += 2 * M_PI * v * dt / 5.3;
 }
 
+int Actor::variant() const {
+  if (!articulated()) return 0;
+  if (kind == ActorKind::Pedestrian && (!moving || v < 0.05)) return kPhaseSteps;
+  const double step = 2 * M_PI / kPhaseSteps;
+  const long k = std::lround(phase / step);
+  return static_cast<int>(((k % kPhaseSteps) + kPhaseSteps) % kPhaseSteps);
+}
+
 TriangleMesh actorMesh(const Actor& a) {
+  const int var = a.variant();
+  const double phase = 2 * M_PI * var / kPhaseSteps;
   switch (a.kind) {
-    case ActorKind::Pedestrian: {
-      const double swing = a.moving && a.v_cruise > 0 ? a.swing_max * std::min(1.0, a.v / a.v_cruise) : 0.0;
-      return pedestrianMesh(a.stature, a.breadth, a.phase, swing, a.surfaces);
-    }
-    case ActorKind::Cyclist: return cyclistMesh(a.length, a.stature, a.phase, a.surfaces);
+    case ActorKind::Pedestrian:
+      return pedestrianMesh(a.stature, a.breadth, phase, var == kPhaseSteps ? 0.0 : a.swing_max, a.surfaces);
+    case ActorKind::Cyclist: return cyclistMesh(a.length, a.stature, phase, a.surfaces);
     default: return carMesh(a.body, a.length, a.width, a.height, a.surfaces);
   }
 }

@@ -1,7 +1,9 @@
 #include "ret3d/sim/ground_truth.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <thread>
 
 #include "ret3d/core/geometry.h"
 #include "ret3d/core/transform.h"
@@ -53,6 +55,16 @@ std::vector<ObjectTruth> labelFrame(const std::vector<Actor>& actors, const RayC
     o.box.num_points = inside;
     if (static_cast<int>(inside) < opt.min_points) continue;
     o.hits = hits[i];
+    out.push_back(std::move(o));
+  }
+
+  // The ray work per object runs on all threads; each object's result depends only on its own rays.
+  std::atomic<std::size_t> next{0};
+  auto work = [&]() {
+    for (std::size_t k = next++; k < out.size(); k = next++) {
+    ObjectTruth& o = out[k];
+    const std::size_t i = o.actor;
+    const Actor& a = actors[i];
 
     // Unoccluded rays: every slot whose ray passes the box's angular window, cast against the actor alone.
     {
@@ -152,8 +164,12 @@ std::vector<ObjectTruth> labelFrame(const std::vector<Actor>& actors, const RayC
       o.camera_visible = own > 0 ? static_cast<double>(seen) / own : 0.0;
       o.label.occluded = occlusionLevel(o.camera_visible);
     }
-    out.push_back(std::move(o));
-  }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < opt.threads; ++t) pool.emplace_back(work);
+  work();
+  for (auto& th : pool) th.join();
   return out;
 }
 

@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <map>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -50,12 +51,16 @@ struct RayCaster::Impl {
   RTCScene static_scene = nullptr;
   RTCGeometry static_inst = nullptr;
   std::vector<Surface> static_surfaces;
-  struct ActorGeom {
+  struct Variant {
     RTCScene scene = nullptr;
-    RTCGeometry mesh = nullptr;
-    RTCGeometry inst = nullptr;
     std::vector<Surface> surfaces;
-    std::size_t vertices = 0, triangles = 0;
+  };
+  struct ActorGeom {
+    std::map<int, Variant> variants;
+    int current = -1;
+    RTCScene scene = nullptr;  // the current variant's
+    const std::vector<Surface>* surfaces = nullptr;
+    RTCGeometry inst = nullptr;
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
     bool enabled = false;
   };
@@ -65,9 +70,8 @@ struct RayCaster::Impl {
   int threads = 2;
 
   ~Impl() {
-    for (auto& a : actors) {
-      if (a.scene) rtcReleaseScene(a.scene);
-    }
+    for (auto& a : actors)
+      for (auto& [k, v] : a.variants) rtcReleaseScene(v.scene);
     if (top) rtcReleaseScene(top);
     if (static_scene) rtcReleaseScene(static_scene);
     if (device) rtcReleaseDevice(device);
@@ -126,11 +130,11 @@ void RayCaster::setStatic(const TriangleMesh& mesh) {
   rtcReleaseGeometry(m.static_inst);
 }
 
-void RayCaster::setActor(std::size_t i, const TriangleMesh& mesh, const Eigen::Isometry3d& pose, bool active) {
+void RayCaster::setActor(std::size_t i, const TriangleMesh& mesh, const Eigen::Isometry3d& pose, bool active,
+                         int variant) {
   Impl& m = *impl_;
   if (m.actors.size() <= i) m.actors.resize(i + 1);
   Impl::ActorGeom& a = m.actors[i];
-  const unsigned id = static_cast<unsigned>(i + 1);
   if (!active) {
     if (a.inst && a.enabled) {
       rtcDisableGeometry(a.inst);
@@ -139,46 +143,34 @@ void RayCaster::setActor(std::size_t i, const TriangleMesh& mesh, const Eigen::I
     }
     return;
   }
-  if (!a.scene || a.vertices != mesh.vertices.size() || a.triangles != mesh.triangles.size()) {
-    if (a.scene) {
-      rtcDetachGeometry(m.top, id);
-      rtcReleaseScene(a.scene);
-    }
-    a.scene = rtcNewScene(m.device);
-    rtcSetSceneBuildQuality(a.scene, RTC_BUILD_QUALITY_LOW);
-    a.mesh = makeMesh(m.device, mesh);
-    rtcAttachGeometry(a.scene, a.mesh);
-    rtcReleaseGeometry(a.mesh);
-    rtcCommitScene(a.scene);
-    a.vertices = mesh.vertices.size();
-    a.triangles = mesh.triangles.size();
+  auto it = a.variants.find(variant);
+  if (it == a.variants.end()) {
+    Impl::Variant v;
+    v.scene = rtcNewScene(m.device);
+    rtcSetSceneBuildQuality(v.scene, RTC_BUILD_QUALITY_MEDIUM);
+    RTCGeometry g = makeMesh(m.device, mesh);
+    rtcAttachGeometry(v.scene, g);
+    rtcReleaseGeometry(g);
+    rtcCommitScene(v.scene);
+    v.surfaces = mesh.surfaces;
+    it = a.variants.emplace(variant, std::move(v)).first;
+  }
+  if (!a.inst) {
     a.inst = rtcNewGeometry(m.device, RTC_GEOMETRY_TYPE_INSTANCE);
-    rtcSetGeometryInstancedScene(a.inst, a.scene);
-    rtcAttachGeometryByID(m.top, a.inst, id);
+    rtcSetGeometryInstancedScene(a.inst, it->second.scene);
+    rtcAttachGeometryByID(m.top, a.inst, static_cast<unsigned>(i + 1));
     rtcReleaseGeometry(a.inst);
     a.enabled = true;
-  } else if (mesh.vertices.size() > 0) {
-    // Same topology: move the vertices (articulation) when they changed.
-    auto* vb = static_cast<float*>(rtcGetGeometryBufferData(a.mesh, RTC_BUFFER_TYPE_VERTEX, 0));
-    bool changed = false;
-    for (std::size_t k = 0; k < mesh.vertices.size() && !changed; ++k)
-      changed = vb[3 * k] != mesh.vertices[k].x() || vb[3 * k + 1] != mesh.vertices[k].y() || vb[3 * k + 2] != mesh.vertices[k].z();
-    if (changed) {
-      for (std::size_t k = 0; k < mesh.vertices.size(); ++k) {
-        vb[3 * k] = mesh.vertices[k].x();
-        vb[3 * k + 1] = mesh.vertices[k].y();
-        vb[3 * k + 2] = mesh.vertices[k].z();
-      }
-      rtcUpdateGeometryBuffer(a.mesh, RTC_BUFFER_TYPE_VERTEX, 0);
-      rtcCommitGeometry(a.mesh);
-      rtcCommitScene(a.scene);
-    }
+  } else {
+    if (a.current != variant) rtcSetGeometryInstancedScene(a.inst, it->second.scene);
     if (!a.enabled) {
       rtcEnableGeometry(a.inst);
       a.enabled = true;
     }
   }
-  a.surfaces = mesh.surfaces;
+  a.current = variant;
+  a.scene = it->second.scene;
+  a.surfaces = &it->second.surfaces;
   a.pose = pose;
   setTransform(a.inst, pose);
   rtcCommitGeometry(a.inst);
@@ -265,7 +257,7 @@ Sweep RayCaster::cast(const Eigen::Isometry3d& T, std::uint64_t seed, int frame,
             } else {
               actor = static_cast<int>(inst) - 1;
               const Impl::ActorGeom& ag = m.actors[actor];
-              if (prim < ag.surfaces.size()) surf = ag.surfaces[prim];
+              if (ag.surfaces && prim < ag.surfaces->size()) surf = (*ag.surfaces)[prim];
               ng = ag.pose.linear() * ng;  // Embree reports instanced normals in object space
             }
             const double range = rh.ray.tfar[k];

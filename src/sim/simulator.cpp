@@ -39,6 +39,7 @@ SequenceReport simulateSequence(const SimOptions& opt, int index,
   TruthOptions topt;
   topt.label_range = cfg.label_range;
   topt.min_points = cfg.label_min_points;
+  topt.threads = opt.threads;
   int frames = opt.frames;
   ReplayData replay;
   const bool replaying = !opt.replay_dir.empty();
@@ -102,7 +103,7 @@ SequenceReport simulateSequence(const SimOptions& opt, int index,
     for (std::size_t i = 0; i < traffic.actors.size(); ++i) {
       const Actor& a = traffic.actors[i];
       const bool near = a.active && (Eigen::Vector2d(a.x, a.y) - T.translation().head<2>()).norm() < sensor.max_range + 10;
-      caster.setActor(i, a.mesh, actorPose(a), near);
+      caster.setActor(i, a.mesh, actorPose(a), near, a.variant());
     }
     caster.commit();
     // Ego motion in the LiDAR frame (for motion distortion): from the previous frame's pose.

@@ -20,6 +20,8 @@
 namespace ret3d {
 namespace sim {
 
+inline constexpr int kPhaseSteps = 16;
+
 enum class ActorKind { Car, Pedestrian, Cyclist, Obstacle };  // Obstacle: a replayed Van/Truck, drawn, not labelled
 
 struct Actor {
@@ -54,6 +56,9 @@ struct Actor {
 
   TriangleMesh mesh;            // in the actor frame, current articulation
   bool articulated() const { return kind == ActorKind::Pedestrian || kind == ActorKind::Cyclist; }
+  // Which of the actor's mesh poses is current: the gait or crank phase quantised to kPhaseSteps steps per cycle
+  // (kPhaseSteps for a pedestrian standing still; always 0 for vehicles). The ray caster keeps one BVH per variant.
+  int variant() const;
   ObjectClass objectClass() const;
 };
 

@@ -32,6 +32,7 @@ struct TruthOptions {
   int min_points = 1;
   int camera_samples = 10;      // rays per side of the 2D box grid for the camera occlusion estimate
   Eigen::Vector2d image_size{1242, 375};
+  int threads = 2;
 };
 
 // Labels one frame. `T_world_lidar` is the sensor pose the sweep was cast from; `ego_velocity`/`yaw_rate` as given

@@ -38,9 +38,10 @@ class RayCaster {
   const SensorModel& sensor() const { return sensor_; }
   // The static scene (once per sequence).
   void setStatic(const TriangleMesh& mesh);
-  // Actor i's mesh (in its own frame) and world pose; `active` false removes it from this frame. Meshes keep their
-  // topology between calls (articulation moves vertices only).
-  void setActor(std::size_t i, const TriangleMesh& mesh, const Eigen::Isometry3d& pose, bool active);
+  // Actor i's mesh (in its own frame) and world pose; `active` false removes it from this frame. Each (actor,
+  // variant) gets its BVH the first time it is seen; later frames with the same variant only move the instance, so an
+  // articulated actor cycling through its quantised poses costs no rebuilds.
+  void setActor(std::size_t i, const TriangleMesh& mesh, const Eigen::Isometry3d& pose, bool active, int variant = 0);
   // Commits the frame's changes.
   void commit();
 
