@@ -1,0 +1,30 @@
+// The base detector's training loop (`ret3d train detector`): k-means anchors, AdamW with warm-up and cosine decay,
+// fixed seeds, augmentation and the multi-scale schedule, checkpoints every few minutes and resume, a progress bar
+// with the losses. The model trained is the very DetectorModel the Detector runs.
+#pragma once
+
+#include <functional>
+#include <string>
+
+#include "ret3d/detector/detector_options.h"
+
+namespace ret3d {
+
+struct DetectorTrainJob {
+  std::string data_dir;       // KITTI tracking layout
+  std::string out_model;      // final model file; checkpoints beside it (<out>.ckpt, <out>.ckpt.optim)
+  DetectorOptions options;
+  std::string config_text;    // the YAML the options came from, stored in the model file
+  bool resume = false;
+  bool progress = true;       // draw the progress bar
+};
+
+struct DetectorTrainResult {
+  int steps = 0;              // optimiser steps in total (including before a resume)
+  double seconds = 0;         // wall time of this run
+  double last_loss = 0;       // mean total loss over the last epoch
+};
+
+DetectorTrainResult trainDetector(const DetectorTrainJob& job);
+
+}  // namespace ret3d

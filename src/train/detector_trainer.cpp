@@ -1,0 +1,168 @@
+#include "ret3d/train/detector_trainer.h"
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <numeric>
+#include <random>
+#include <sstream>
+
+#include <torch/torch.h>
+#include <yaml-cpp/yaml.h>
+
+#include "ret3d/bev/bev_encoder.h"
+#include "ret3d/core/log.h"
+#include "ret3d/core/progress.h"
+#include "ret3d/detector/anchors.h"
+#include "ret3d/detector/nn/model.h"
+#include "ret3d/train/detector_dataset.h"
+
+namespace ret3d {
+
+namespace {
+
+struct Checkpoint {
+  int epoch = 0;  // the epoch in progress
+  int batch = 0;  // batches of that epoch already done
+  int step = 0;
+};
+
+void writeCheckpoint(const std::string& base, const nn::DetectorModel& model, torch::optim::AdamW& optim,
+                     const Checkpoint& c, const std::string& config_text) {
+  model.save(base + ".ckpt", config_text);
+  torch::save(optim, base + ".ckpt.optim");
+  YAML::Emitter e;
+  e << YAML::BeginMap << YAML::Key << "epoch" << YAML::Value << c.epoch << YAML::Key << "batch" << YAML::Value
+    << c.batch << YAML::Key << "step" << YAML::Value << c.step << YAML::EndMap;
+  const std::string tmp = base + ".ckpt.state.tmp";
+  std::ofstream(tmp) << e.c_str() << "\n";
+  std::filesystem::rename(tmp, base + ".ckpt.state");
+}
+
+// Learning rate: linear warm-up, then cosine decay to 5 % of the peak.
+double learningRate(const TrainOptions& t, int step, int total) {
+  const int warm = std::max(1, static_cast<int>(t.warmup_fraction * total));
+  if (step < warm) return t.learning_rate * (step + 1) / warm;
+  const double p = static_cast<double>(step - warm) / std::max(1, total - warm);
+  return t.learning_rate * (0.05 + 0.95 * 0.5 * (1 + std::cos(M_PI * std::min(1.0, p))));
+}
+
+}  // namespace
+
+DetectorTrainResult trainDetector(const DetectorTrainJob& job) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  const DetectorOptions& o = job.options;
+  const TrainOptions& t = o.train;
+  o.model.validate();
+  torch::set_num_threads(o.inference.threads);
+  torch::manual_seed(t.seed);
+
+  DetectorDataset data(job.data_dir, o.model, t.max_frames);
+  RET3D_INFO("train detector: " << data.size() << " frames from " << job.data_dir << ", head "
+                                << headTypeName(o.model.head) << ", grid " << o.model.geometry.describe());
+
+  std::shared_ptr<nn::DetectorModel> model;
+  Checkpoint ck;
+  const std::string base = job.out_model;
+  if (job.resume && std::filesystem::exists(base + ".ckpt.state")) {
+    model = nn::DetectorModel::load(base + ".ckpt", &o.model);
+    const YAML::Node st = YAML::LoadFile(base + ".ckpt.state");
+    ck.epoch = st["epoch"].as<int>();
+    ck.batch = st["batch"].as<int>();
+    ck.step = st["step"].as<int>();
+    RET3D_INFO("resuming from " << base << ".ckpt at epoch " << ck.epoch + 1 << ", batch " << ck.batch << ", step "
+                                << ck.step);
+  } else {
+    if (job.resume) RET3D_WARN("--resume: no checkpoint at " << base << ".ckpt.state; starting afresh");
+    std::vector<Anchor> anchors;
+    if (o.model.head == HeadType::Anchor) {
+      anchors = kmeansAnchors(data.allBoxes(), o.model.classes, o.model.anchor.anchors_per_class, t.seed);
+      for (const Anchor& a : anchors)
+        RET3D_INFO("anchor " << className(a.label) << ": " << a.length << " x " << a.width << " x " << a.height
+                             << " at z " << a.z);
+    }
+    model = std::make_shared<nn::DetectorModel>(o.model, anchors);
+  }
+  model->net->train();
+  torch::optim::AdamW optim(model->net->parameters(),
+                            torch::optim::AdamWOptions(t.learning_rate).weight_decay(t.weight_decay));
+  if (job.resume && ck.step > 0) torch::load(optim, base + ".ckpt.optim");
+
+  const int batches_per_epoch = static_cast<int>((data.size() + t.batch_size - 1) / t.batch_size);
+  const int total_steps = batches_per_epoch * t.epochs;
+  ProgressBar bar("train detector", static_cast<std::size_t>(total_steps));
+  if (ck.step > 0) bar.tick(static_cast<std::size_t>(ck.step));
+  auto last_ckpt = std::chrono::steady_clock::now();
+  DetectorTrainResult result;
+  BevEncoderOptions enc_opt = o.bevOptions();
+
+  for (int epoch = ck.epoch; epoch < t.epochs; ++epoch) {
+    // The order of an epoch and each sample's augmentation depend only on (seed, epoch, position): a resumed run
+    // sees exactly the batches the interrupted one would have.
+    std::vector<std::size_t> order(data.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::mt19937 order_rng(t.seed * 7919u + static_cast<unsigned>(epoch));
+    std::shuffle(order.begin(), order.end(), order_rng);
+    double epoch_loss = 0;
+    int epoch_batches = 0;
+    for (int b = (epoch == ck.epoch ? ck.batch : 0); b < batches_per_epoch; ++b) {
+      std::mt19937 rng(t.seed * 104729u + static_cast<unsigned>(epoch) * 1009u + static_cast<unsigned>(b));
+      enc_opt.geometry = multiscaleGeometry(o.model.geometry, t, &rng);
+      const BevEncoder encoder(enc_opt);
+      std::vector<nn::GroundTruth> gts;
+      std::vector<torch::Tensor> inputs;
+      for (int k = 0; k < t.batch_size; ++k) {
+        const std::size_t pos = static_cast<std::size_t>(b) * t.batch_size + k;
+        if (pos >= order.size()) break;
+        DetectorSample s = data.load(order[pos]);
+        augmentSample(&s, t, &rng);
+        const BevImage img = encoder.encode(s.current, s.has_previous ? &s.previous : nullptr, s.prev_to_current);
+        inputs.push_back(nn::bevToTensor(img));
+        nn::GroundTruth gt;
+        gt.boxes = std::move(s.boxes);
+        gt.velocity_valid = std::move(s.velocity_valid);
+        gt.ignore = std::move(s.ignore);
+        gt.supervised_fov_deg = t.supervised_fov_deg;
+        gts.push_back(std::move(gt));
+      }
+      const double lr = learningRate(t, ck.step, total_steps);
+      for (auto& group : optim.param_groups())
+        static_cast<torch::optim::AdamWOptions&>(group.options()).lr(lr);
+      optim.zero_grad();
+      const nn::NetworkOutput out = model->forward(torch::cat(inputs));
+      nn::HeadLoss loss = model->head().loss(out, gts, enc_opt.geometry, t);
+      loss.total.backward();
+      torch::nn::utils::clip_grad_norm_(model->net->parameters(), 10.0);
+      optim.step();
+      ++ck.step;
+      const double lv = loss.total.item<double>();
+      epoch_loss += lv;
+      ++epoch_batches;
+      std::ostringstream info;
+      info << std::fixed << std::setprecision(3) << "ep " << epoch + 1 << "/" << t.epochs << " loss " << lv;
+      for (const auto& [name, v] : loss.parts) info << " " << name << " " << v;
+      if (job.progress) bar.tick(1, info.str());
+      if (!std::isfinite(lv)) throw std::runtime_error("train detector: the loss is not finite at step " + std::to_string(ck.step));
+      const double since = std::chrono::duration<double>(std::chrono::steady_clock::now() - last_ckpt).count();
+      if (since > 60.0 * t.checkpoint_minutes) {
+        writeCheckpoint(base, *model, optim, {epoch, b + 1, ck.step}, job.config_text);
+        last_ckpt = std::chrono::steady_clock::now();
+      }
+    }
+    ck.batch = 0;
+    if (epoch_batches > 0) result.last_loss = epoch_loss / epoch_batches;
+  }
+  bar.finish();
+  model->net->eval();
+  model->save(job.out_model, job.config_text);
+  writeCheckpoint(base, *model, optim, {t.epochs, 0, ck.step}, job.config_text);
+  result.steps = ck.step;
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  RET3D_INFO("train detector: " << ck.step << " steps in " << std::fixed << std::setprecision(0) << result.seconds
+                                << " s; model written to " << job.out_model);
+  return result;
+}
+
+}  // namespace ret3d

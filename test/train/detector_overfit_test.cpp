@@ -1,0 +1,281 @@
+// The training loop learns: a small network trained on a few hand-made frames (boxes filled with points on a ground
+// plane, written as a tiny KITTI tracking dataset) must then find every object of those frames (3D IoU > 0.5) with
+// few false positives, for both heads. Also: the dataset reads velocities from track ids and ego poses, and a run
+// resumed from its checkpoint continues rather than restarts.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "ret3d/core/geometry.h"
+#include "ret3d/detector/detector.h"
+#include "ret3d/io/kitti.h"
+#include "ret3d/train/detector_dataset.h"
+#include "ret3d/train/detector_trainer.h"
+#include "test_util.h"
+
+namespace ret3d {
+namespace {
+
+constexpr int kFrames = 6;
+
+struct Scene {
+  std::vector<std::vector<Box>> boxes;  // per frame, LiDAR frame
+  std::vector<PointCloud> clouds;
+};
+
+// Points on a ground plane and inside each box (a lattice filling its volume), intensity by class.
+PointCloud render(const std::vector<Box>& boxes, std::mt19937* rng) {
+  PointCloud c;
+  std::uniform_real_distribution<float> jitter(-0.04f, 0.04f);
+  for (float x = 0.1f; x < 32.0f; x += 0.35f)
+    for (float y = -15.9f; y < 16.0f; y += 0.35f) c.push_back({x + jitter(*rng), y + jitter(*rng), -1.73f, 0.05f});
+  for (const Box& b : boxes) {
+    const float inten = b.label == ObjectClass::Car ? 0.6f : b.label == ObjectClass::Pedestrian ? 0.3f : 0.9f;
+    const double cy = std::cos(b.yaw), sy = std::sin(b.yaw);
+    for (double l = -0.5 * b.length + 0.05; l < 0.5 * b.length; l += 0.15)
+      for (double w = -0.5 * b.width + 0.05; w < 0.5 * b.width; w += 0.15)
+        for (double h = -0.5 * b.height + 0.05; h < 0.5 * b.height; h += 0.2)
+          c.push_back({static_cast<float>(b.x + cy * l - sy * w), static_cast<float>(b.y + sy * l + cy * w),
+                       static_cast<float>(b.z + h), inten});
+  }
+  return c;
+}
+
+// Five tracked objects moving across six frames, written with the KITTI writers (static ego, identity poses).
+Scene writeDataset(const std::string& root) {
+  namespace fs = std::filesystem;
+  const std::string tr = root + "/training";
+  fs::create_directories(tr + "/velodyne/0000");
+  fs::create_directories(tr + "/label_02");
+  fs::create_directories(tr + "/calib");
+  fs::create_directories(tr + "/pose");
+  const kitti::Calibration calib = kitti::defaultCalibration();
+  kitti::writeCalibration(tr + "/calib/0000.txt", calib);
+  struct Obj {
+    ObjectClass c;
+    double x, y, yaw, vx, vy, l, w, h;
+  };
+  const std::vector<Obj> objs = {{ObjectClass::Car, 9, -4, 0.2, 5, 1, 4.0, 1.7, 1.5},
+                                 {ObjectClass::Car, 17, 5, -1.4, 0, -6, 4.4, 1.8, 1.6},
+                                 {ObjectClass::Pedestrian, 7, 3, 1.0, 0.5, 1.0, 0.7, 0.6, 1.75},
+                                 {ObjectClass::Pedestrian, 13, -8, -2.5, -1.0, 0.0, 0.8, 0.6, 1.8},
+                                 {ObjectClass::Cyclist, 22, -2, 2.8, -4, 1, 1.8, 0.6, 1.7}};
+  Scene scene;
+  std::mt19937 rng(11);
+  std::vector<kitti::Label> labels;
+  std::vector<Eigen::Isometry3d> poses;
+  for (int f = 0; f < kFrames; ++f) {
+    std::vector<Box> boxes;
+    for (std::size_t i = 0; i < objs.size(); ++i) {
+      const Obj& o = objs[i];
+      Box b;
+      b.label = o.c;
+      b.x = o.x + o.vx * 0.1 * f, b.y = o.y + o.vy * 0.1 * f;
+      b.length = o.l, b.width = o.w, b.height = o.h;
+      b.z = -1.73 + 0.5 * o.h;
+      b.yaw = o.yaw;
+      b.vx = o.vx, b.vy = o.vy;
+      b.track_id = static_cast<std::uint32_t>(i + 1);
+      boxes.push_back(b);
+      kitti::Label l = kitti::boxToLabel(b, calib);
+      l.frame = f;
+      labels.push_back(l);
+    }
+    scene.clouds.push_back(render(boxes, &rng));
+    char name[64];
+    std::snprintf(name, sizeof(name), "/velodyne/0000/%06d.bin", f);
+    kitti::writeVelodyne(tr + name, scene.clouds.back());
+    scene.boxes.push_back(boxes);
+    poses.push_back(Eigen::Isometry3d::Identity());
+  }
+  kitti::writeTrackingLabels(tr + "/label_02/0000.txt", labels);
+  kitti::writePoses(tr + "/pose/0000.txt", poses);
+  return scene;
+}
+
+DetectorOptions tinyOptions(HeadType head) {
+  DetectorOptions o;
+  auto& m = o.model;
+  m.geometry.x_min = 0, m.geometry.x_max = 32, m.geometry.y_min = -16, m.geometry.y_max = 16;
+  m.geometry.resolution = 0.25;  // 128 x 128
+  m.network.stem_channels = 16;
+  m.network.stage_channels = {24, 32, 48};
+  m.network.stage_blocks = {1, 1, 1};
+  m.network.attention_heads = 2;
+  m.network.decoder_channels = 32;
+  m.network.head_channels = 32;
+  m.head = head;
+  m.anchor.anchors_per_class = 1;
+  auto& t = o.train;
+  t.epochs = 90;
+  t.batch_size = 2;
+  t.learning_rate = 4e-3;
+  t.warmup_fraction = 0.05;
+  t.rotation_range = 0;  // overfitting: the frames as they are (flips keep the task the same)
+  t.scale_min = t.scale_max = 1.0;
+  t.crop_probability = 0;
+  t.block_probability = 0;
+  t.checkpoint_minutes = 100;
+  o.inference.score_threshold = 0.3f;
+  // One thread: on a machine shared with other jobs, two OpenMP threads wait on each other at every small op.
+  o.inference.threads = 1;
+  return o;
+}
+
+// Average precision of one class at 3D IoU > 0.5 with greedy matching by score (all-point interpolation).
+double averagePrecision(const std::vector<std::vector<Box>>& dets, const std::vector<std::vector<Box>>& gts,
+                        ObjectClass c, int* false_positives) {
+  struct Hit {
+    float score;
+    bool tp;
+  };
+  std::vector<Hit> hits;
+  int n_gt = 0;
+  for (std::size_t f = 0; f < gts.size(); ++f) {
+    std::vector<Box> d;
+    for (const Box& b : dets[f])
+      if (b.label == c) d.push_back(b);
+    std::sort(d.begin(), d.end(), [](const Box& a, const Box& b) { return a.score > b.score; });
+    std::vector<bool> used(gts[f].size(), false);
+    for (const Box& g : gts[f]) n_gt += g.label == c;
+    for (const Box& b : d) {
+      int best = -1;
+      double best_iou = 0.5;
+      for (std::size_t g = 0; g < gts[f].size(); ++g) {
+        if (used[g] || gts[f][g].label != c) continue;
+        const double iou = iou3d(b, gts[f][g]);
+        if (iou > best_iou) best_iou = iou, best = static_cast<int>(g);
+      }
+      if (best >= 0) used[best] = true;
+      hits.push_back({b.score, best >= 0});
+    }
+  }
+  std::sort(hits.begin(), hits.end(), [](const Hit& a, const Hit& b) { return a.score > b.score; });
+  std::vector<double> prec, rec;
+  int tp = 0, fp = 0;
+  for (const Hit& h : hits) {
+    h.tp ? ++tp : ++fp;
+    prec.push_back(static_cast<double>(tp) / (tp + fp));
+    rec.push_back(static_cast<double>(tp) / std::max(1, n_gt));
+  }
+  *false_positives = fp;
+  double ap = 0, prev_r = 0;
+  for (std::size_t i = 0; i < prec.size(); ++i) {
+    const double p = *std::max_element(prec.begin() + i, prec.end());
+    ap += (rec[i] - prev_r) * p;
+    prev_r = rec[i];
+  }
+  return ap;
+}
+
+class DetectorOverfitTest : public ::testing::TestWithParam<HeadType> {};
+
+TEST_P(DetectorOverfitTest, ReachesNearPerfectAPOnItsTrainingFrames) {
+  test::TempDir dir;
+  const Scene scene = writeDataset(dir.path());
+  DetectorTrainJob job;
+  job.data_dir = dir.path();
+  job.out_model = dir / "tiny.ret3d";
+  job.options = tinyOptions(GetParam());
+  job.config_text = "# overfit test\n";
+  job.progress = false;
+  const DetectorTrainResult r = trainDetector(job);
+  std::printf("%s head: %d steps in %.1f s, last epoch loss %.3f\n", headTypeName(GetParam()), r.steps, r.seconds,
+              r.last_loss);
+  EXPECT_EQ(r.steps, job.options.train.epochs * 3);
+
+  DetectorOptions o = job.options;
+  o.inference.model_path = job.out_model;
+  Detector detector(o);
+  std::vector<std::vector<Box>> dets;
+  std::vector<double> vel_err;
+  for (int f = 0; f < kFrames; ++f) {
+    const PointCloud* prev = f > 0 ? &scene.clouds[f - 1] : nullptr;
+    const Detections d = detector.detect(scene.clouds[f], prev, Eigen::Isometry3d::Identity());
+    EXPECT_EQ(d.feature_dim, 32u);
+    dets.push_back(d.boxes);
+    if (f == 0) continue;
+    for (const Box& g : scene.boxes[f])
+      for (const Box& b : d.boxes)
+        if (b.label == g.label && iou3d(b, g) > 0.5) {
+          vel_err.push_back(std::hypot(b.vx - g.vx, b.vy - g.vy));
+          break;
+        }
+  }
+  for (ObjectClass c : kDetectedClasses) {
+    int fp = 0;
+    const double ap = averagePrecision(dets, scene.boxes, c, &fp);
+    std::printf("  %s AP(3D IoU 0.5) %.3f, false positives %d\n", className(c), ap, fp);
+    EXPECT_GE(ap, 0.9) << className(c);
+    EXPECT_LE(fp, 3) << className(c);
+  }
+  ASSERT_FALSE(vel_err.empty());
+  std::sort(vel_err.begin(), vel_err.end());
+  std::printf("  median velocity error %.2f m/s over %zu matches\n", vel_err[vel_err.size() / 2], vel_err.size());
+  EXPECT_LT(vel_err[vel_err.size() / 2], 1.5);
+}
+
+INSTANTIATE_TEST_SUITE_P(BothHeads, DetectorOverfitTest, ::testing::Values(HeadType::Center, HeadType::Anchor),
+                         [](const auto& info) { return std::string(headTypeName(info.param)); });
+
+TEST(DetectorDataset, VelocitiesFromTrackIdsAndEgoMotion) {
+  test::TempDir dir;
+  const Scene scene = writeDataset(dir.path());
+  const DetectorOptions o = tinyOptions(HeadType::Center);
+  DetectorDataset data(dir.path(), o.model);
+  ASSERT_EQ(data.size(), static_cast<std::size_t>(kFrames));
+  EXPECT_EQ(data.allBoxes().size(), 5u * kFrames);
+  const DetectorSample first = data.load(0), third = data.load(2);
+  EXPECT_FALSE(first.has_previous);
+  EXPECT_TRUE(third.has_previous);
+  EXPECT_EQ(third.previous.size(), scene.clouds[1].size());
+  ASSERT_EQ(third.boxes.size(), 5u);
+  for (std::size_t i = 0; i < 5; ++i) {
+    const Box& g = scene.boxes[2][i];
+    const Box& b = third.boxes[i];
+    EXPECT_NEAR(b.x, g.x, 0.02);
+    EXPECT_NEAR(b.y, g.y, 0.02);
+    EXPECT_NEAR(b.vx, g.vx, 0.3) << i;  // label rounding (centimetres over 0.1 s)
+    EXPECT_NEAR(b.vy, g.vy, 0.3) << i;
+    EXPECT_TRUE(third.velocity_valid[i]);
+    // Frame 0 has no previous frame: the velocity comes from the next one.
+    EXPECT_NEAR(first.boxes[i].vx, g.vx, 0.3);
+  }
+}
+
+TEST(DetectorDataset, AugmentationMovesPointsAndBoxesTogether) {
+  test::TempDir dir;
+  const Scene scene = writeDataset(dir.path());
+  DetectorOptions o = tinyOptions(HeadType::Center);
+  DetectorDataset data(dir.path(), o.model);
+  DetectorSample s = data.load(3);
+  o.train.rotation_range = 1.0;
+  o.train.scale_min = 0.9, o.train.scale_max = 1.1;
+  o.train.flip = true;
+  std::mt19937 rng(4);
+  augmentSample(&s, o.train, &rng);
+  // Every object keeps the points that were inside it (boxes lifted off the ground plane, whose points lie on
+  // their bottom faces, so boundary rounding does not count).
+  auto lifted = [](std::vector<Box> boxes) {
+    for (Box& b : boxes) b.z += 0.1, b.height -= 0.2;
+    return boxes;
+  };
+  const auto before = countPointsInBoxes(lifted(scene.boxes[3]), scene.clouds[3]);
+  const auto after = countPointsInBoxes(lifted(s.boxes), s.current);
+  ASSERT_EQ(before.size(), after.size());
+  for (std::size_t i = 0; i < before.size(); ++i) EXPECT_NEAR(after[i], before[i], 0.02 * before[i] + 2) << i;
+  // Multi-scale grid: 32 (12 + n) cells.
+  o.train.multiscale_base = 12, o.train.multiscale_n_min = -2, o.train.multiscale_n_max = 0;
+  for (int i = 0; i < 10; ++i) {
+    const BevGeometry g = multiscaleGeometry(o.model.geometry, o.train, &rng);
+    EXPECT_TRUE(g.width() == 320 || g.width() == 352 || g.width() == 384) << g.width();
+    EXPECT_EQ(g.width(), g.height());
+  }
+}
+
+}  // namespace
+}  // namespace ret3d
