@@ -47,7 +47,7 @@ ap_row "PointRCNN (base)" "$OUT/base/report" "- | -" | tee -a "$ROWS"
 for cfg in $CONFIGS; do
   echo "== $cfg"
   start=$(date +%s)
-  "$RET3D" train-intra --data "$DATA" --detections "$DETS" --sequences "$TRAIN_SEQ" \
+  "$RET3D" train intra --data "$DATA" --detections "$DETS" --sequences "$TRAIN_SEQ" \
     --config "$ROOT/config/relation/$cfg.yaml" --out "$OUT/$cfg/model.pt" --threads "$THREADS" --quiet \
     > "$OUT/$cfg.train.log" 2>&1
   secs=$(( $(date +%s) - start ))

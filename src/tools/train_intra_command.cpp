@@ -1,6 +1,6 @@
-// `ret3d train-intra`: trains IntraRM (Ret3D §3.2) on another detector's boxes, or prints a model's metadata.
-//   ret3d train-intra --data ../shared/data/kitti_tracking --detections ../shared/data/kitti_tracking/detections/pointrcnn
-//                     --sequences 1-15 --out models/kitti_pointrcnn/intra_rm.pt
+// `ret3d train intra`: trains IntraRM (Ret3D §3.2) on another detector's boxes, or prints a model's metadata.
+//   ret3d train intra --data ../shared/data/kitti_tracking --detections ../shared/data/kitti_tracking/detections/pointrcnn
+//                     --sequences 1-15 --config config/relation/intra_rm.yaml --out models/kitti_pointrcnn/intra_rm.pt
 #include <filesystem>
 #include <iostream>
 #include <sstream>
@@ -9,7 +9,7 @@
 #include "ret3d/eval/eval_data.h"
 #include "ret3d/relation/intra_rm.h"
 #include "ret3d/train/intra_trainer.h"
-#include "tools/command.h"
+#include "tools/train_command.h"
 
 namespace ret3d {
 namespace tools {
@@ -70,8 +70,8 @@ int runTrainIntra(const TrainIntraArgs& a) {
   return 0;
 }
 
-CommandRegistrar reg("train-intra", "train IntraRM (Ret3D intra-frame relation module) on detections",
-                     [](CLI::App& app) -> CommandRun {
+TrainRegistrar reg("intra", "IntraRM (Ret3D intra-frame relation module) on another detector's boxes",
+                   [](CLI::App& app) -> CommandRun {
   auto a = std::make_shared<TrainIntraArgs>();
   app.add_option("--data", a->data, "KITTI tracking (or object) root with labels and calibration");
   app.add_option("--detections", a->detections,
@@ -89,7 +89,7 @@ CommandRegistrar reg("train-intra", "train IntraRM (Ret3D intra-frame relation m
   app.add_option("--inspect", a->inspect, "print a model file's metadata and exit");
   return [a, &app]() {
     std::ostringstream cmd;
-    cmd << "ret3d train-intra";
+    cmd << "ret3d train intra";
     for (const auto* o : app.get_options()) {
       if (o->count() == 0 || o->get_name() == "--help") continue;
       cmd << " " << o->get_name();
