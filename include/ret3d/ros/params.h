@@ -1,0 +1,99 @@
+// Parameters of the pipeline nodelets: one plain struct per nodelet, built by one function from the ROS parameter
+// server (config/ret3d.yaml loaded with rosparam by launch/ret3d.launch), and validated there. An invalid value throws
+// ParamError naming the parameter, its value and what is allowed; the nodelet then refuses to start. Where a stage
+// has its own option loader and validation (tracker, detector, relation model files), it is reused, not repeated.
+#pragma once
+
+#include <ros/node_handle.h>
+#include <xmlrpcpp/XmlRpcValue.h>
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "ret3d/detector/detector_options.h"
+#include "ret3d/relation/inter_rm.h"
+#include "ret3d/relation/intra_rm.h"
+#include "ret3d/ros/conversions.h"
+#include "ret3d/ros/markers.h"
+#include "ret3d/tracking/tracker_options.h"
+
+namespace ret3d {
+
+class ParamError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Typed reads of a node handle's parameters with defaults and ranges. Every failure throws ParamError
+// "parameter <ns>/<name> = <value>: <what is allowed>".
+class ParamReader {
+ public:
+  explicit ParamReader(const ros::NodeHandle& nh) : nh_(nh) {}
+  std::string string(const std::string& name, const std::string& fallback) const;
+  // Non-empty string.
+  std::string nonEmpty(const std::string& name, const std::string& fallback) const;
+  // One of `allowed`.
+  std::string choice(const std::string& name, const std::string& fallback, const std::vector<std::string>& allowed) const;
+  double number(const std::string& name, double fallback, double min, double max) const;  // inclusive range
+  int integer(const std::string& name, int fallback, int min, int max) const;
+  bool boolean(const std::string& name, bool fallback) const;
+  bool has(const std::string& name) const { return nh_.hasParam(name); }
+  // The full name of a parameter, for messages ("/ret3d_tracker/max_age").
+  std::string fullName(const std::string& name) const { return nh_.resolveName(name); }
+  // A dictionary parameter as YAML text (for a stage's own YAML loader); empty when the parameter is absent.
+  std::string yaml(const std::string& name) const;
+
+ private:
+  ros::NodeHandle nh_;
+};
+
+// A parameter value (any XmlRpc type) as YAML text.
+std::string toYaml(const XmlRpc::XmlRpcValue& value);
+
+// The package's share folder (ros::package::getPath("ret3d")), for the default config and model paths; empty when
+// the package cannot be found.
+std::string packagePath();
+// Default model files: $(find ret3d)/models/lwd3d/{detector,intra_rm,inter_rm}.pt.
+std::string defaultModelPath(const std::string& file_name);
+
+// What every stage that needs the sensor's pose shares.
+struct PoseParams {
+  std::string fixed_frame = "odom";
+  double tf_timeout = 0.05;  // s to wait for a transform at the cloud's stamp
+};
+
+struct DetectorNodeletParams {
+  DetectorOptions detector;          // ~config (YAML file) then ~model_path, ~threads, ~score_threshold, ~nms_iou,
+                                     // ~max_detections
+  CloudConversionOptions cloud;      // ~intensity_scaling (auto|datatype|observed_max|fixed), ~intensity_scale
+  PoseParams pose;
+  double max_sweep_gap = 0.25;       // s: an older previous sweep is not used (LWD-3D's second sweep is 0.1 s back)
+};
+struct IntraRMNodeletParams {
+  relation::IntraRMOptions intra;    // ~model_path, ~threads
+};
+struct TrackerNodeletParams {
+  TrackerOptions tracker;            // ~tracker (inline dictionary) or ~tracker_config (YAML file)
+  PoseParams pose;
+};
+struct InterRMNodeletParams {
+  relation::InterRMOptions inter;    // ~model_path, ~threads
+  bool passthrough = false;          // ~passthrough: no model, tracked boxes published unrefined (stage off)
+  PoseParams pose;
+  // Histories of track ids not seen for more than this many frames are dropped (the tracker's max_age by default:
+  // a track that coasts longer than that never comes back with the same id).
+  int max_age = TrackerOptions().max_age;
+};
+struct MarkerNodeletParams {
+  MarkerOptions markers;
+  PoseParams pose;
+};
+
+DetectorNodeletParams loadDetectorNodeletParams(const ros::NodeHandle& private_nh);
+IntraRMNodeletParams loadIntraRMNodeletParams(const ros::NodeHandle& private_nh);
+TrackerNodeletParams loadTrackerNodeletParams(const ros::NodeHandle& private_nh);
+InterRMNodeletParams loadInterRMNodeletParams(const ros::NodeHandle& private_nh);
+MarkerNodeletParams loadMarkerNodeletParams(const ros::NodeHandle& private_nh);
+
+}  // namespace ret3d

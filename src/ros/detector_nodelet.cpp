@@ -1,0 +1,111 @@
+// ret3d/DetectorNodelet: points (PointCloud2 of any layout) -> LWD-3D Detector -> detections (DetectionArray with the
+// per-object features). The previous sweep is kept for LWD-3D's two-sweep input; its motion to the current sweep
+// comes from tf2 (both sensor poses in the fixed frame). What the nodelet works around, it says (throttled): a cloud
+// without intensity or with NaN points (from the conversion report), an empty or malformed cloud (empty detections
+// published), a missing transform (previous sweep used without motion compensation), stamps going backwards or a gap
+// longer than ~max_sweep_gap (previous sweep dropped).
+#include <pluginlib/class_list_macros.hpp>
+#include <sensor_msgs/PointCloud2.h>
+
+#include <optional>
+
+#include "ret3d/DetectionArray.h"
+#include "ret3d/detector/detector.h"
+#include "ret3d/ros/conversions.h"
+#include "ret3d/ros/detection_array.h"
+#include "ret3d/ros/nodelets.h"
+
+namespace ret3d {
+
+class DetectorNodelet : public StageNodelet<sensor_msgs::PointCloud2> {
+ public:
+  ~DetectorNodelet() override { stopWorker(); }
+
+ private:
+  void setup() override {
+    params_ = loadDetectorNodeletParams(getPrivateNodeHandle());
+    detector_ = constructStage(getPrivateNodeHandle(), "model_path", params_.detector.inference.model_path,
+                               [&] { return std::make_unique<Detector>(params_.detector); });
+    poses_ = std::make_unique<PoseSource>(params_.pose, getNodeHandle());
+    publisher_ = getNodeHandle().advertise<ret3d::DetectionArray>("detections", 1);
+    start("points");
+  }
+
+  void process(const sensor_msgs::PointCloud2::ConstPtr& msg) override {
+    const double stamp = msg->header.stamp.toSec();
+    Detections empty;
+    empty.feature_dim = static_cast<std::size_t>(detector_->featureDim());
+
+    CloudConversionReport report;
+    PointCloud cloud;
+    try {
+      cloud = toCloud(*msg, params_.cloud, &report);
+    } catch (const std::exception& e) {
+      degraded("malformed", std::string("malformed cloud, no detections for it: ") + e.what());
+      publisher_.publish(toDetectionArrayMsg(empty, msg->header));
+      return;
+    }
+    for (const std::string& w : report.warnings) degraded("conversion: " + w.substr(0, 20), "cloud: " + w);
+    if (report.dropped_nonfinite > 0) {
+      degraded("nonfinite", "dropped " + std::to_string(report.dropped_nonfinite) + " of " +
+                                std::to_string(report.input_points) + " points with a NaN or Inf coordinate");
+    }
+    if (cloud.empty()) {
+      degraded("empty", "empty cloud (after dropping invalid points): no detections");
+      publisher_.publish(toDetectionArrayMsg(empty, msg->header));
+      return;
+    }
+
+    const PoseSource::Result pose = poses_->lookup(msg->header.frame_id, msg->header.stamp);
+    const PointCloud* previous = nullptr;
+    Eigen::Isometry3d prev_to_current = Eigen::Isometry3d::Identity();
+    if (previous_) {
+      const double gap = stamp - previous_->stamp;
+      if (gap <= 0.0) {
+        degraded("backwards", "stamp went backwards or repeated (" + std::to_string(previous_->stamp) + " -> " +
+                                  std::to_string(stamp) + "): previous sweep dropped");
+      } else if (gap > params_.max_sweep_gap) {
+        degraded("gap", "previous sweep " + std::to_string(gap) + " s old (> ~max_sweep_gap): not used");
+      } else if (previous_->frame_id != msg->header.frame_id) {
+        degraded("frame", "frame id changed from " + previous_->frame_id + ": previous sweep dropped");
+      } else {
+        previous = &previous_->cloud;
+        if (pose.found && previous_->pose_found) {
+          prev_to_current = pose.sensor_to_fixed.inverse() * previous_->sensor_to_fixed;
+        } else {
+          degraded("tf", "no transform " + msg->header.frame_id + " -> " + poses_->fixedFrame() + " at " +
+                             std::to_string(stamp) + " (" + (pose.found ? "previous sweep" : pose.problem) +
+                             "): previous sweep used without motion compensation");
+        }
+      }
+    }
+
+    const Detections detections = detector_->detect(cloud, previous, prev_to_current);
+    publisher_.publish(toDetectionArrayMsg(detections, msg->header));
+
+    if (!previous_) previous_.emplace();
+    previous_->cloud = std::move(cloud);
+    previous_->stamp = stamp;
+    previous_->frame_id = msg->header.frame_id;
+    previous_->sensor_to_fixed = pose.sensor_to_fixed;
+    previous_->pose_found = pose.found;
+  }
+
+  struct Sweep {
+    PointCloud cloud;
+    double stamp = 0.0;
+    std::string frame_id;
+    Eigen::Isometry3d sensor_to_fixed = Eigen::Isometry3d::Identity();
+    bool pose_found = false;
+  };
+
+  DetectorNodeletParams params_;
+  std::unique_ptr<Detector> detector_;
+  std::unique_ptr<PoseSource> poses_;
+  ros::Publisher publisher_;
+  std::optional<Sweep> previous_;
+};
+
+}  // namespace ret3d
+
+PLUGINLIB_EXPORT_CLASS(ret3d::DetectorNodelet, nodelet::Nodelet)

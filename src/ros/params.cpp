@@ -1,0 +1,227 @@
+// Parameter loading and validation for the nodelets (include/ret3d/ros/params.h).
+#include "ret3d/ros/params.h"
+
+#include <ros/package.h>
+
+#include <sstream>
+#include <yaml-cpp/yaml.h>
+
+namespace ret3d {
+namespace {
+
+std::string show(const XmlRpc::XmlRpcValue& v) {
+  std::string s = toYaml(v);
+  while (!s.empty() && s.back() == '\n') s.pop_back();
+  return s;
+}
+
+void emit(YAML::Emitter& out, const XmlRpc::XmlRpcValue& v) {
+  XmlRpc::XmlRpcValue& value = const_cast<XmlRpc::XmlRpcValue&>(v);  // XmlRpc's accessors are not const
+  switch (value.getType()) {
+    case XmlRpc::XmlRpcValue::TypeBoolean: out << static_cast<bool>(value); break;
+    case XmlRpc::XmlRpcValue::TypeInt: out << static_cast<int>(value); break;
+    case XmlRpc::XmlRpcValue::TypeDouble: out << static_cast<double>(value); break;
+    case XmlRpc::XmlRpcValue::TypeString: out << static_cast<std::string>(value); break;
+    case XmlRpc::XmlRpcValue::TypeArray:
+      out << YAML::BeginSeq;
+      for (int i = 0; i < value.size(); ++i) emit(out, value[i]);
+      out << YAML::EndSeq;
+      break;
+    case XmlRpc::XmlRpcValue::TypeStruct:
+      out << YAML::BeginMap;
+      for (auto it = value.begin(); it != value.end(); ++it) {
+        out << YAML::Key << it->first << YAML::Value;
+        emit(out, it->second);
+      }
+      out << YAML::EndMap;
+      break;
+    default: out << YAML::Null; break;
+  }
+}
+
+PoseParams loadPoseParams(const ParamReader& p) {
+  PoseParams pose;
+  pose.fixed_frame = p.nonEmpty("fixed_frame", pose.fixed_frame);
+  pose.tf_timeout = p.number("tf_timeout", pose.tf_timeout, 0.0, 5.0);
+  return pose;
+}
+
+}  // namespace
+
+std::string toYaml(const XmlRpc::XmlRpcValue& value) {
+  YAML::Emitter out;
+  emit(out, value);
+  return std::string(out.c_str()) + "\n";
+}
+
+std::string ParamReader::string(const std::string& name, const std::string& fallback) const {
+  XmlRpc::XmlRpcValue v;
+  if (!nh_.getParam(name, v)) return fallback;
+  if (v.getType() != XmlRpc::XmlRpcValue::TypeString) {
+    throw ParamError("parameter " + fullName(name) + " = " + show(v) + ": must be a string");
+  }
+  return static_cast<std::string>(v);
+}
+
+std::string ParamReader::nonEmpty(const std::string& name, const std::string& fallback) const {
+  const std::string s = string(name, fallback);
+  if (s.empty()) throw ParamError("parameter " + fullName(name) + " = '': must not be empty");
+  return s;
+}
+
+std::string ParamReader::choice(const std::string& name, const std::string& fallback,
+                                const std::vector<std::string>& allowed) const {
+  const std::string s = string(name, fallback);
+  for (const auto& a : allowed) {
+    if (s == a) return s;
+  }
+  std::string list;
+  for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+  throw ParamError("parameter " + fullName(name) + " = '" + s + "': must be one of " + list);
+}
+
+double ParamReader::number(const std::string& name, double fallback, double min, double max) const {
+  XmlRpc::XmlRpcValue v;
+  double x = fallback;
+  if (nh_.getParam(name, v)) {
+    if (v.getType() == XmlRpc::XmlRpcValue::TypeDouble) {
+      x = static_cast<double>(v);
+    } else if (v.getType() == XmlRpc::XmlRpcValue::TypeInt) {
+      x = static_cast<int>(v);
+    } else {
+      throw ParamError("parameter " + fullName(name) + " = " + show(v) + ": must be a number in [" +
+                       std::to_string(min) + ", " + std::to_string(max) + "]");
+    }
+  }
+  if (!(x >= min && x <= max)) {
+    std::ostringstream s;
+    s << "parameter " << fullName(name) << " = " << x << ": must be in [" << min << ", " << max << "]";
+    throw ParamError(s.str());
+  }
+  return x;
+}
+
+int ParamReader::integer(const std::string& name, int fallback, int min, int max) const {
+  XmlRpc::XmlRpcValue v;
+  int x = fallback;
+  if (nh_.getParam(name, v)) {
+    if (v.getType() != XmlRpc::XmlRpcValue::TypeInt) {
+      throw ParamError("parameter " + fullName(name) + " = " + show(v) + ": must be an integer in [" +
+                       std::to_string(min) + ", " + std::to_string(max) + "]");
+    }
+    x = static_cast<int>(v);
+  }
+  if (x < min || x > max) {
+    throw ParamError("parameter " + fullName(name) + " = " + std::to_string(x) + ": must be an integer in [" +
+                     std::to_string(min) + ", " + std::to_string(max) + "]");
+  }
+  return x;
+}
+
+bool ParamReader::boolean(const std::string& name, bool fallback) const {
+  XmlRpc::XmlRpcValue v;
+  if (!nh_.getParam(name, v)) return fallback;
+  if (v.getType() != XmlRpc::XmlRpcValue::TypeBoolean) {
+    throw ParamError("parameter " + fullName(name) + " = " + show(v) + ": must be true or false");
+  }
+  return static_cast<bool>(v);
+}
+
+std::string ParamReader::yaml(const std::string& name) const {
+  XmlRpc::XmlRpcValue v;
+  if (!nh_.getParam(name, v)) return "";
+  if (v.getType() != XmlRpc::XmlRpcValue::TypeStruct) {
+    throw ParamError("parameter " + fullName(name) + " = " + show(v) + ": must be a dictionary");
+  }
+  return toYaml(v);
+}
+
+std::string packagePath() { return ros::package::getPath("ret3d"); }
+
+std::string defaultModelPath(const std::string& file_name) { return packagePath() + "/models/lwd3d/" + file_name; }
+
+DetectorNodeletParams loadDetectorNodeletParams(const ros::NodeHandle& private_nh) {
+  const ParamReader p(private_nh);
+  DetectorNodeletParams params;
+  const std::string config = p.nonEmpty("config", packagePath() + "/config/detector/lwd3d_center.yaml");
+  try {
+    params.detector = loadDetectorOptions(config);
+  } catch (const std::exception& e) {
+    throw ParamError("parameter " + p.fullName("config") + " = '" + config + "': " + e.what());
+  }
+  InferenceOptions& inf = params.detector.inference;
+  // An untrained network would publish noise: the nodelet always needs a model file.
+  inf.model_path = p.nonEmpty("model_path", defaultModelPath("detector.pt"));
+  inf.threads = p.integer("threads", inf.threads, 1, 64);
+  inf.score_threshold = static_cast<float>(p.number("score_threshold", inf.score_threshold, 0.0, 1.0));
+  inf.nms_iou = p.number("nms_iou", inf.nms_iou, 0.01, 1.0);
+  inf.max_detections = p.integer("max_detections", inf.max_detections, 1, 100000);
+  const std::string scaling =
+      p.choice("intensity_scaling", "auto", {"auto", "datatype", "observed_max", "fixed"});
+  params.cloud.intensity_scaling = scaling == "auto"           ? IntensityScaling::Auto
+                                   : scaling == "datatype"     ? IntensityScaling::DatatypeRange
+                                   : scaling == "observed_max" ? IntensityScaling::ObservedMax
+                                                               : IntensityScaling::FixedScale;
+  params.cloud.intensity_scale = p.number("intensity_scale", params.cloud.intensity_scale, 1e-6, 1e9);
+  params.pose = loadPoseParams(p);
+  params.max_sweep_gap = p.number("max_sweep_gap", params.max_sweep_gap, 0.0, 10.0);
+  return params;
+}
+
+IntraRMNodeletParams loadIntraRMNodeletParams(const ros::NodeHandle& private_nh) {
+  const ParamReader p(private_nh);
+  IntraRMNodeletParams params;
+  params.intra.model_path = p.nonEmpty("model_path", defaultModelPath("intra_rm.pt"));
+  params.intra.threads = p.integer("threads", 2, 1, 64);
+  return params;
+}
+
+TrackerNodeletParams loadTrackerNodeletParams(const ros::NodeHandle& private_nh) {
+  const ParamReader p(private_nh);
+  TrackerNodeletParams params;
+  // Inline (~tracker: {max_age: 5, ...}) or a file (~tracker_config); either way the tracker's own loader, which
+  // refuses unknown keys and invalid values.
+  const std::string inline_yaml = p.yaml("tracker");
+  if (!inline_yaml.empty()) {
+    try {
+      params.tracker = parseTrackerOptions(inline_yaml);
+    } catch (const std::exception& e) {
+      throw ParamError("parameter " + p.fullName("tracker") + ": " + e.what());
+    }
+  } else {
+    const std::string file = p.nonEmpty("tracker_config", packagePath() + "/config/tracker.yaml");
+    try {
+      params.tracker = loadTrackerOptions(file);
+    } catch (const std::exception& e) {
+      throw ParamError("parameter " + p.fullName("tracker_config") + " = '" + file + "': " + e.what());
+    }
+  }
+  params.pose = loadPoseParams(p);
+  return params;
+}
+
+InterRMNodeletParams loadInterRMNodeletParams(const ros::NodeHandle& private_nh) {
+  const ParamReader p(private_nh);
+  InterRMNodeletParams params;
+  params.passthrough = p.boolean("passthrough", false);
+  params.inter.model_path = p.nonEmpty("model_path", defaultModelPath("inter_rm.pt"));
+  params.inter.threads = p.integer("threads", 2, 1, 64);
+  params.max_age = p.integer("max_age", params.max_age, 0, 1000);
+  params.pose = loadPoseParams(p);
+  return params;
+}
+
+MarkerNodeletParams loadMarkerNodeletParams(const ros::NodeHandle& private_nh) {
+  const ParamReader p(private_nh);
+  MarkerNodeletParams params;
+  MarkerOptions& m = params.markers;
+  m.trail_length = p.integer("trail_length", m.trail_length, 0, 1000);
+  m.line_width = p.number("line_width", m.line_width, 0.001, 10.0);
+  m.text_size = p.number("text_size", m.text_size, 0.01, 100.0);
+  m.min_arrow_speed = p.number("min_arrow_speed", m.min_arrow_speed, 0.0, 1000.0);
+  m.arrow_seconds = p.number("arrow_seconds", m.arrow_seconds, 0.0, 100.0);
+  params.pose = loadPoseParams(p);
+  return params;
+}
+
+}  // namespace ret3d
