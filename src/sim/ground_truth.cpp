@@ -115,6 +115,7 @@ std::vector<ObjectTruth> labelFrame(const std::vector<Actor>& actors, const RayC
     // Camera: where the mesh projects, how much is outside the image, how much is hidden behind other things.
     o.label = kitti::boxToLabel(o.box, calib, opt.image_size);
     o.label.frame = frame;
+    o.label.score.reset();  // ground truth, not a detection
     const Eigen::Isometry3d T_lidar_actor = T_lidar_world * actorPose(a);
     double u0 = 1e18, v0 = 1e18, u1 = -1e18, v1 = -1e18;
     std::size_t total = 0, in_image = 0;

@@ -113,6 +113,7 @@ TEST(Simulator, UrbanFramesLookLikeKittiAndBoxesHoldTheirPoints) {
       EXPECT_NEAR(lb.z, b.z, 0.01);
       EXPECT_EQ(labels[i].track_id, info[i].track);
       EXPECT_EQ(labels[i].type, info[i].cls);
+      EXPECT_FALSE(labels[i].score.has_value()) << "ground truth carries no score";
       if (b.num_points < 5) continue;
       const std::uint32_t inside = countPointsInBox(b, cloud);
       EXPECT_GE(inside, b.num_points) << info[i].cls << " track " << info[i].track << " frame " << f;
