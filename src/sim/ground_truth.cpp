@@ -62,109 +62,109 @@ std::vector<ObjectTruth> labelFrame(const std::vector<Actor>& actors, const RayC
   std::atomic<std::size_t> next{0};
   auto work = [&]() {
     for (std::size_t k = next++; k < out.size(); k = next++) {
-    ObjectTruth& o = out[k];
-    const std::size_t i = o.actor;
-    const Actor& a = actors[i];
+      ObjectTruth& o = out[k];
+      const std::size_t i = o.actor;
+      const Actor& a = actors[i];
 
-    // Unoccluded rays: every slot whose ray passes the box's angular window, cast against the actor alone.
-    {
-      const auto corners = boxCorners(o.box);
-      const double az0 = std::atan2(o.box.y, o.box.x);
-      double lo = 0, hi = 0;
-      for (const auto& c : corners) {
-        const double d = std::remainder(std::atan2(c.y(), c.x()) - az0, 2 * M_PI);
-        lo = std::min(lo, d);
-        hi = std::max(hi, d);
-      }
-      // Nearest horizontal distance to the footprint (for the elevation extremes).
-      double rmin = 1e9, rmax = 0;
-      for (const auto& c : bevCorners(o.box)) rmax = std::max(rmax, c.norm());
+      // Unoccluded rays: every slot whose ray passes the box's angular window, cast against the actor alone.
       {
-        Box flat = o.box;
-        if (pointInBox(flat, Eigen::Vector3d(0, 0, o.box.z))) rmin = 0.1;
-        const auto bc = bevCorners(o.box);
-        for (int k = 0; k < 4; ++k) {
-          const Eigen::Vector2d p = bc[k], q = bc[(k + 1) % 4], d = q - p;
-          const double t = std::clamp(-p.dot(d) / d.squaredNorm(), 0.0, 1.0);
-          rmin = std::min(rmin, (p + t * d).norm());
+        const auto corners = boxCorners(o.box);
+        const double az0 = std::atan2(o.box.y, o.box.x);
+        double lo = 0, hi = 0;
+        for (const auto& c : corners) {
+          const double d = std::remainder(std::atan2(c.y(), c.x()) - az0, 2 * M_PI);
+          lo = std::min(lo, d);
+          hi = std::max(hi, d);
         }
-      }
-      const double ztop = o.box.top(), zbot = o.box.bottom();
-      const double el_hi = std::atan2(ztop, ztop > 0 ? rmin : rmax) * 180 / M_PI;
-      const double el_lo = std::atan2(zbot, zbot < 0 ? rmin : rmax) * 180 / M_PI;
-      const double dcol = 2 * M_PI / cols;
-      // Column c has azimuth pi - (c + 0.5) dcol; a few columns of slack for motion distortion.
-      const int slack = sensor.motion_distortion ? 6 : 1;
-      const int c_first = static_cast<int>(std::floor((M_PI - (az0 + hi)) / dcol - 0.5)) - slack;
-      const int c_last = static_cast<int>(std::ceil((M_PI - (az0 + lo)) / dcol - 0.5)) + slack;
-      std::uint32_t un = 0;
-      for (int b = 0; b < beams; ++b) {
-        const double el = sensor.elevation_deg[b];
-        if (el < el_lo - 0.5 || el > el_hi + 0.5) continue;
-        for (int cc = c_first; cc <= c_last; ++cc) {
-          const int c = ((cc % cols) + cols) % cols;
-          Eigen::Vector3d org, dir;
-          caster.slotRay(T_world_lidar, c, b, ego_velocity, yaw_rate, &org, &dir);
-          if (caster.intersectActorOnly(i, org, dir, sensor.min_range, sensor.max_range)) ++un;
+        // Nearest horizontal distance to the footprint (for the elevation extremes).
+        double rmin = 1e9, rmax = 0;
+        for (const auto& c : bevCorners(o.box)) rmax = std::max(rmax, c.norm());
+        {
+          Box flat = o.box;
+          if (pointInBox(flat, Eigen::Vector3d(0, 0, o.box.z))) rmin = 0.1;
+          const auto bc = bevCorners(o.box);
+          for (int k = 0; k < 4; ++k) {
+            const Eigen::Vector2d p = bc[k], q = bc[(k + 1) % 4], d = q - p;
+            const double t = std::clamp(-p.dot(d) / d.squaredNorm(), 0.0, 1.0);
+            rmin = std::min(rmin, (p + t * d).norm());
+          }
         }
+        const double ztop = o.box.top(), zbot = o.box.bottom();
+        const double el_hi = std::atan2(ztop, ztop > 0 ? rmin : rmax) * 180 / M_PI;
+        const double el_lo = std::atan2(zbot, zbot < 0 ? rmin : rmax) * 180 / M_PI;
+        const double dcol = 2 * M_PI / cols;
+        // Column c has azimuth pi - (c + 0.5) dcol; a few columns of slack for motion distortion.
+        const int slack = sensor.motion_distortion ? 6 : 1;
+        const int c_first = static_cast<int>(std::floor((M_PI - (az0 + hi)) / dcol - 0.5)) - slack;
+        const int c_last = static_cast<int>(std::ceil((M_PI - (az0 + lo)) / dcol - 0.5)) + slack;
+        std::uint32_t un = 0;
+        for (int b = 0; b < beams; ++b) {
+          const double el = sensor.elevation_deg[b];
+          if (el < el_lo - 0.5 || el > el_hi + 0.5) continue;
+          for (int cc = c_first; cc <= c_last; ++cc) {
+            const int c = ((cc % cols) + cols) % cols;
+            Eigen::Vector3d org, dir;
+            caster.slotRay(T_world_lidar, c, b, ego_velocity, yaw_rate, &org, &dir);
+            if (caster.intersectActorOnly(i, org, dir, sensor.min_range, sensor.max_range)) ++un;
+          }
+        }
+        o.unoccluded = std::max(un, o.hits);
+        o.visible_fraction = o.unoccluded > 0 ? static_cast<double>(o.hits) / o.unoccluded : 0.0;
       }
-      o.unoccluded = std::max(un, o.hits);
-      o.visible_fraction = o.unoccluded > 0 ? static_cast<double>(o.hits) / o.unoccluded : 0.0;
-    }
 
-    // Camera: where the mesh projects, how much is outside the image, how much is hidden behind other things.
-    o.label = kitti::boxToLabel(o.box, calib, opt.image_size);
-    o.label.frame = frame;
-    o.label.score.reset();  // ground truth, not a detection
-    const Eigen::Isometry3d T_lidar_actor = T_lidar_world * actorPose(a);
-    double u0 = 1e18, v0 = 1e18, u1 = -1e18, v1 = -1e18;
-    std::size_t total = 0, in_image = 0;
-    for (const auto& v : a.mesh.vertices) {
-      ++total;
-      const Eigen::Vector3d r = calib.veloToRect(T_lidar_actor * v.cast<double>());
-      if (r.z() < 0.1) continue;
-      const auto px = calib.projectRect(r);
-      if (!px) continue;
-      const bool inside_img = px->x() >= 0 && px->y() >= 0 && px->x() <= opt.image_size.x() - 1 &&
-                              px->y() <= opt.image_size.y() - 1;
-      if (inside_img) ++in_image;
-      u0 = std::min(u0, px->x());
-      v0 = std::min(v0, px->y());
-      u1 = std::max(u1, px->x());
-      v1 = std::max(v1, px->y());
-    }
-    o.camera_truncation = total > 0 ? 1.0 - static_cast<double>(in_image) / total : 1.0;
-    u0 = std::clamp(u0, 0.0, opt.image_size.x() - 1);
-    u1 = std::clamp(u1, 0.0, opt.image_size.x() - 1);
-    v0 = std::clamp(v0, 0.0, opt.image_size.y() - 1);
-    v1 = std::clamp(v1, 0.0, opt.image_size.y() - 1);
-    if (in_image == 0 || u1 - u0 < 1 || v1 - v0 < 1) {
-      o.label.bbox = {0, 0, 0, 0};
-      o.label.truncated = 2;
-      o.label.occluded = 3;
-      o.camera_truncation = 1.0;
-      o.camera_visible = 0;
-    } else {
-      o.label.bbox = {u0, v0, u1, v1};
-      // Tracking-layout truncation levels: 0 in the image, 1 partly outside, 2 (almost) all outside.
-      o.label.truncated = o.camera_truncation < 0.1 ? 0 : (o.camera_truncation < 0.9 ? 1 : 2);
-      int own = 0, seen = 0;
-      const int n = opt.camera_samples;
-      for (int iu = 0; iu < n; ++iu) {
-        for (int iv = 0; iv < n; ++iv) {
-          const double u = u0 + (u1 - u0) * (iu + 0.5) / n, v = v0 + (v1 - v0) * (iv + 0.5) / n;
-          const Eigen::Vector3d p_lidar = calib.rectToVelo(cam_rect + Kinv * Eigen::Vector3d(u, v, 1));
-          const Eigen::Vector3d dir = (T_world_lidar.linear() * (p_lidar - cam_lidar)).normalized();
-          if (!caster.intersectActorOnly(i, cam_world, dir, 0.1, 200.0)) continue;
-          ++own;
-          double t = 0;
-          int hit = -1;
-          if (caster.intersect(cam_world, dir, 0.1, 200.0, &t, &hit) && hit == static_cast<int>(i)) ++seen;
-        }
+      // Camera: where the mesh projects, how much is outside the image, how much is hidden behind other things.
+      o.label = kitti::boxToLabel(o.box, calib, opt.image_size);
+      o.label.frame = frame;
+      o.label.score.reset();  // ground truth, not a detection
+      const Eigen::Isometry3d T_lidar_actor = T_lidar_world * actorPose(a);
+      double u0 = 1e18, v0 = 1e18, u1 = -1e18, v1 = -1e18;
+      std::size_t total = 0, in_image = 0;
+      for (const auto& v : a.mesh.vertices) {
+        ++total;
+        const Eigen::Vector3d r = calib.veloToRect(T_lidar_actor * v.cast<double>());
+        if (r.z() < 0.1) continue;
+        const auto px = calib.projectRect(r);
+        if (!px) continue;
+        const bool inside_img = px->x() >= 0 && px->y() >= 0 && px->x() <= opt.image_size.x() - 1 &&
+                                px->y() <= opt.image_size.y() - 1;
+        if (inside_img) ++in_image;
+        u0 = std::min(u0, px->x());
+        v0 = std::min(v0, px->y());
+        u1 = std::max(u1, px->x());
+        v1 = std::max(v1, px->y());
       }
-      o.camera_visible = own > 0 ? static_cast<double>(seen) / own : 0.0;
-      o.label.occluded = occlusionLevel(o.camera_visible);
-    }
+      o.camera_truncation = total > 0 ? 1.0 - static_cast<double>(in_image) / total : 1.0;
+      u0 = std::clamp(u0, 0.0, opt.image_size.x() - 1);
+      u1 = std::clamp(u1, 0.0, opt.image_size.x() - 1);
+      v0 = std::clamp(v0, 0.0, opt.image_size.y() - 1);
+      v1 = std::clamp(v1, 0.0, opt.image_size.y() - 1);
+      if (in_image == 0 || u1 - u0 < 1 || v1 - v0 < 1) {
+        o.label.bbox = {0, 0, 0, 0};
+        o.label.truncated = 2;
+        o.label.occluded = 3;
+        o.camera_truncation = 1.0;
+        o.camera_visible = 0;
+      } else {
+        o.label.bbox = {u0, v0, u1, v1};
+        // Tracking-layout truncation levels: 0 in the image, 1 partly outside, 2 (almost) all outside.
+        o.label.truncated = o.camera_truncation < 0.1 ? 0 : (o.camera_truncation < 0.9 ? 1 : 2);
+        int own = 0, seen = 0;
+        const int n = opt.camera_samples;
+        for (int iu = 0; iu < n; ++iu) {
+          for (int iv = 0; iv < n; ++iv) {
+            const double u = u0 + (u1 - u0) * (iu + 0.5) / n, v = v0 + (v1 - v0) * (iv + 0.5) / n;
+            const Eigen::Vector3d p_lidar = calib.rectToVelo(cam_rect + Kinv * Eigen::Vector3d(u, v, 1));
+            const Eigen::Vector3d dir = (T_world_lidar.linear() * (p_lidar - cam_lidar)).normalized();
+            if (!caster.intersectActorOnly(i, cam_world, dir, 0.1, 200.0)) continue;
+            ++own;
+            double t = 0;
+            int hit = -1;
+            if (caster.intersect(cam_world, dir, 0.1, 200.0, &t, &hit) && hit == static_cast<int>(i)) ++seen;
+          }
+        }
+        o.camera_visible = own > 0 ? static_cast<double>(seen) / own : 0.0;
+        o.label.occluded = occlusionLevel(o.camera_visible);
+      }
     }
   };
   std::vector<std::thread> pool;
