@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
+
+#include "test_util.h"
 
 namespace ret3d {
 namespace eval {
@@ -174,6 +177,80 @@ TEST(MotMetrics, MissingTrackIdIsAnError) {
   auto frames = groundTruth();
   frames[3].pred_boxes = {car(3, 0, 0)};
   EXPECT_THROW(evaluateMot(frames), std::invalid_argument);
+}
+
+// Real ground truth (KITTI tracking sequence 0001) as predictions, then with injected errors whose effect is
+// known: an ID switch in the middle of the longest car track (+1 IDSW), a two-frame gap in another car track
+// (+2 FN, +1 FRAG), and a false track of 20 frames far from everything (+20 FP).
+TEST(MotMetrics, RealGroundTruthWithInjectedErrors) {
+  const auto shared = test::sharedDataDir();
+  if (!shared) GTEST_SKIP() << test::kSharedDataMissing;
+  EvalData data = loadKittiTracking(*shared + "/kitti_tracking/training", "", {"0001"});
+  MotOptions o;
+  o.classes = {ObjectClass::Car};
+  std::map<std::uint32_t, std::vector<int>> car_frames;  // track id -> frames where it is a (non-ignored) car
+  for (auto& f : data.frames) {
+    f.pred_boxes.clear();
+    for (std::size_t g = 0; g < f.gt_boxes.size(); ++g) {
+      if (f.gt_ignore[g]) continue;
+      Box p = f.gt_boxes[g];
+      p.track_id += 1000;
+      f.pred_boxes.push_back(p);
+      if (p.label == ObjectClass::Car) car_frames[f.gt_boxes[g].track_id].push_back(f.frame);
+    }
+  }
+  const MotResult base_all = evaluateMot(data.frames, o);
+  const ClearMot base = base_all.classes[0].clear;
+  EXPECT_NEAR(base.mota, 100.0, 1e-9);
+  EXPECT_EQ(base.idsw, 0);
+  EXPECT_NEAR(base_all.classes[0].hota.hota, 100.0, 1e-6);
+
+  // The longest car track gets a new id from its middle frame on.
+  std::uint32_t longest = 0;
+  for (const auto& [id, fr] : car_frames) {
+    if (!longest || fr.size() > car_frames[longest].size()) longest = id;
+  }
+  const int switch_at = car_frames[longest][car_frames[longest].size() / 2];
+  // Another car track seen in three consecutive frames a, a+1, a+2 (and on): drop its prediction in a+1 and a+2,
+  // then it resumes at a+3.
+  std::uint32_t gapped = 0;
+  int gap_at = -1;
+  for (const auto& [id, fr] : car_frames) {
+    if (id == longest) continue;
+    for (std::size_t k = 0; k + 3 < fr.size(); ++k) {
+      if (fr[k + 3] == fr[k] + 3) {
+        gapped = id;
+        gap_at = fr[k] + 1;
+        break;
+      }
+    }
+    if (gapped) break;
+  }
+  ASSERT_TRUE(gapped);
+  for (auto& f : data.frames) {
+    std::vector<Box> kept;
+    for (Box p : f.pred_boxes) {
+      if (p.track_id == longest + 1000 && f.frame >= switch_at) p.track_id = 5000;
+      if (p.track_id == gapped + 1000 && (f.frame == gap_at || f.frame == gap_at + 1)) continue;
+      kept.push_back(p);
+    }
+    if (f.frame < 20) {
+      Box ghost = kept.empty() ? Box() : kept.front();
+      ghost.x = 200.0;
+      ghost.y = 200.0;
+      ghost.label = ObjectClass::Car;
+      ghost.track_id = 9999;
+      kept.push_back(ghost);
+    }
+    f.pred_boxes = kept;
+  }
+  const ClearMot c = evaluateMot(data.frames, o).classes[0].clear;
+  EXPECT_EQ(c.idsw, base.idsw + 1);
+  EXPECT_EQ(c.frag, base.frag + 1);
+  EXPECT_EQ(c.fn, base.fn + 2);
+  EXPECT_EQ(c.fp, base.fp + 20);
+  const int gt = base.num_gt;
+  EXPECT_NEAR(c.mota, 100.0 * ((gt - 2) - 20 - 1) / gt, 1e-9);
 }
 
 }  // namespace
