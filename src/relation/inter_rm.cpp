@@ -45,7 +45,7 @@ std::vector<Box> InterRM::refine(const std::vector<InterRMSequence>& sequences) 
   for (const auto& s : sequences) ptrs.push_back(&s);
   torch::InferenceMode guard;
   const InterRMInputs in = makeInterRMInputs(ptrs, arch().max_history);
-  return applyInterRMOutput(ptrs, impl_->net->forward(in));
+  return applyInterRMOutput(ptrs, impl_->net->forward(in), arch().regress_size);
 }
 
 }  // namespace relation

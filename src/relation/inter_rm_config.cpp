@@ -92,7 +92,9 @@ InterRMConfig parseInterRMConfig(const std::string& yaml_text, const std::string
   if (root.IsNull()) return c;
   checkKeys(root, {"model", "train"}, source, "<top>");
   if (const YAML::Node m = root["model"]) {
-    checkKeys(m, {"c_enc", "heads", "ffn_expansion", "positional_encoding", "max_history"}, source, "model");
+    checkKeys(m, {"c_enc", "heads", "ffn_expansion", "positional_encoding", "max_history", "regress_size"}, source,
+              "model");
+    read(m, "regress_size", &c.model.regress_size, source, "model");
     read(m, "c_enc", &c.model.c_enc, source, "model");
     read(m, "heads", &c.model.heads, source, "model");
     read(m, "ffn_expansion", &c.model.ffn_expansion, source, "model");
@@ -153,6 +155,7 @@ std::string toYaml(const InterRMConfig& c) {
   e << YAML::Key << "ffn_expansion" << YAML::Value << c.model.ffn_expansion;
   e << YAML::Key << "positional_encoding" << YAML::Value << positionalEncodingName(c.model.positional_encoding);
   e << YAML::Key << "max_history" << YAML::Value << c.model.max_history;
+  e << YAML::Key << "regress_size" << YAML::Value << c.model.regress_size;
   e << YAML::EndMap;
   e << YAML::Key << "train" << YAML::Value << YAML::BeginMap;
   e << YAML::Key << "lr" << YAML::Value << c.train.lr;

@@ -55,7 +55,12 @@ struct InterRMLearner::Impl {
       for (int k = 0; k < kInterOutputs; ++k) acc[static_cast<int64_t>(i)][k] = r[static_cast<std::size_t>(k)];
     }
     const torch::Tensor pred = net()->forward(makeInterRMInputs(seqs, config.model.max_history));
-    const torch::Tensor l = torch::smooth_l1_loss(pred, target, at::Reduction::None, config.train.smooth_l1_beta);
+    torch::Tensor l = torch::smooth_l1_loss(pred, target, at::Reduction::None, config.train.smooth_l1_beta);
+    if (!config.model.regress_size) {  // the size outputs are not used: no loss on them
+      torch::Tensor w = torch::ones({1, kInterOutputs});
+      w.slice(1, 3, 6).zero_();
+      l = l * w;
+    }
     const torch::Tensor per = l.sum(1);  // per sequence: all seven residuals
     const torch::Tensor total = per.mean();
     InterRMLoss L;
@@ -189,7 +194,8 @@ bool InterRMLearner::loadCheckpoint(const std::string& dir, int* epoch, double* 
   const InterRMArch& a = saved.arch();
   const InterRMArch& b = impl_->config.model;
   if (a.c_enc != b.c_enc || a.heads != b.heads || a.ffn_expansion != b.ffn_expansion ||
-      a.positional_encoding != b.positional_encoding || a.max_history != b.max_history)
+      a.positional_encoding != b.positional_encoding || a.max_history != b.max_history ||
+      a.regress_size != b.regress_size)
     throw std::runtime_error("InterRM checkpoint " + dir + ": its network differs from the configuration (" +
                              toYaml({a, {}}) + ")");
   torch::NoGradGuard no_grad;

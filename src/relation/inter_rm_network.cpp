@@ -163,7 +163,8 @@ torch::Tensor InterRMNetImpl::forward(const InterRMInputs& in) {
   return head(a_ref);
 }
 
-std::vector<Box> applyInterRMOutput(const std::vector<const InterRMSequence*>& sequences, const torch::Tensor& out) {
+std::vector<Box> applyInterRMOutput(const std::vector<const InterRMSequence*>& sequences, const torch::Tensor& out,
+                                    bool apply_size) {
   const torch::Tensor o = out.to(torch::kDouble).contiguous();
   const auto acc = o.accessor<double, 2>();
   std::vector<Box> boxes;
@@ -176,9 +177,11 @@ std::vector<Box> applyInterRMOutput(const std::vector<const InterRMSequence*>& s
     b.y += sn * acc[r][0] + cs * acc[r][1];
     b.z += acc[r][2];
     // Clamped like the targets can be: a size change beyond e^{+-1} is not a refinement.
-    b.length *= std::exp(std::clamp(acc[r][3], -1.0, 1.0));
-    b.width *= std::exp(std::clamp(acc[r][4], -1.0, 1.0));
-    b.height *= std::exp(std::clamp(acc[r][5], -1.0, 1.0));
+    if (apply_size) {
+      b.length *= std::exp(std::clamp(acc[r][3], -1.0, 1.0));
+      b.width *= std::exp(std::clamp(acc[r][4], -1.0, 1.0));
+      b.height *= std::exp(std::clamp(acc[r][5], -1.0, 1.0));
+    }
     b.yaw = wrapAngle(b.yaw + std::clamp(acc[r][6], -M_PI / 2, M_PI / 2));
     boxes.push_back(b);
   }

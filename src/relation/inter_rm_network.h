@@ -52,7 +52,8 @@ struct InterRM::Impl {
 };
 
 // Applies predicted residuals (B x 7) to each sequence's current box.
-std::vector<Box> applyInterRMOutput(const std::vector<const InterRMSequence*>& sequences, const torch::Tensor& out);
+std::vector<Box> applyInterRMOutput(const std::vector<const InterRMSequence*>& sequences, const torch::Tensor& out,
+                                    bool apply_size);
 
 std::string interRMMetadataYaml(const InterRMModelInfo& info);
 void saveInterRMModel(const std::string& path, const InterRM::Impl& impl);

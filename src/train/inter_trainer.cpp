@@ -155,12 +155,14 @@ InterTrainReport trainInterRM(const std::vector<InterRMSample>& train, const std
   }
   if (!val.empty() && start_epoch == 0) {
     // The untrained module is the identity: its loss is that of the input boxes, the bar to beat.
-    report.initial_val_loss = learner.evaluate(val).total;
+    const relation::InterRMLoss V0 = learner.evaluate(val);
+    report.initial_val_loss = V0.total;
     best_val = report.initial_val_loss;
     // Written now, so that if no epoch beats the input boxes the model file is the identity, never a worse module.
     learner.model().save(options.out_path);
     report.best_epoch = 0;
-    RET3D_INFO("InterRM: validation loss of the input boxes (identity) " << report.initial_val_loss);
+    RET3D_INFO("InterRM: validation loss of the input boxes (identity) " << V0.total << " (loc " << V0.loc << " size "
+                                                                         << V0.size << " yaw " << V0.yaw << ")");
   }
   const auto t0 = std::chrono::steady_clock::now();
   const std::size_t bs = static_cast<std::size_t>(cfg.train.sequences_per_batch);

@@ -40,6 +40,9 @@ struct InterRMArch {
   int ffn_expansion = 2;  // FFN hidden width = ffn_expansion * c_enc (eq. 9)
   InterPositionalEncoding positional_encoding = InterPositionalEncoding::Implicit;
   int max_history = 30;   // entries used per sequence (the newest ones, current included); longer ones are cut
+  // Also regress the size (the paper regresses "the locations and heading degrees" only, §3.3). On the KITTI
+  // PointRCNN boxes the learned size residuals did not carry over to held-out sequences (docs/RESULTS.md).
+  bool regress_size = true;
 
   void validate() const;  // throws std::invalid_argument naming the field
 };
@@ -103,8 +106,8 @@ class InterRM {
   InterRM(InterRM&&) noexcept;
   InterRM& operator=(InterRM&&) noexcept;
 
-  // Refines the current box of every sequence; returns one box per sequence: boxes[0] with refined centre, size and
-  // heading (residuals; the heading residual is within [-pi/2, pi/2)), everything else (score, label, velocity, track
+  // Refines the current box of every sequence; returns one box per sequence: boxes[0] with refined centre, heading
+  // and (arch().regress_size) size (residuals; the heading residual is within [-pi/2, pi/2)), everything else (score, label, velocity, track
   // id, point count) kept. Throws std::invalid_argument for an empty sequence, dt of another length, or non-finite
   // fields.
   std::vector<Box> refine(const std::vector<InterRMSequence>& sequences) const;
