@@ -1,0 +1,275 @@
+// rostest (test/pipeline_detector_test.test): the DetectorNodelet in a real nodelet manager (in-process
+// nodelet::Loader) with a real model file (a freshly initialised LWD-3D network saved by the model's own save
+// function, on a small BEV grid so that the test is quick on 2 cores). It is fed clouds a user may have: the velodyne
+// layout with tf, an Ouster layout (organized, padded, float intensity in the thousands, uint32 time), no intensity,
+// empty, all NaN, a million points, stamps going backwards, a frame without tf. For every cloud a DetectionArray comes
+// out with the cloud's stamp and frame id, and the nodelet says what it worked around. A model that does not fit the
+// configuration, or a missing one, makes it refuse to start with a message naming the parameter.
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <tf2_msgs/TFMessage.h>
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <mutex>
+#include <sstream>
+
+#include "nodes/pipeline_test_util.h"
+#include "ret3d/DetectionArray.h"
+#include "ret3d/core/transform.h"
+#include "ret3d/detector/detector.h"
+#include "ret3d/detector/nn/model.h"
+#include "ret3d/ros/conversions.h"
+#include "ros/tiny_sequence.h"
+#ifndef RET3D_SOURCE_DIR
+#define RET3D_SOURCE_DIR ""
+#endif
+#include "test_util.h"
+
+namespace ret3d {
+namespace {
+
+// The default detector config with a 96 x 96 cell grid (48 m at 0.5 m): the same network, a quarter of the work.
+std::string smallConfig(const std::string& source_dir) {
+  std::ifstream in(source_dir + "/config/detector/lwd3d_center.yaml");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::string text = ss.str();
+  auto replace = [&](const std::string& from, const std::string& to) {
+    const auto pos = text.find(from);
+    if (pos != std::string::npos) text.replace(pos, from.size(), to);
+  };
+  replace("x_min: -48.0", "x_min: -24.0");
+  replace("x_max: 48.0", "x_max: 24.0");
+  replace("y_min: -48.0", "y_min: -24.0");
+  replace("y_max: 48.0", "y_max: 24.0");
+  replace("resolution: 0.25", "resolution: 0.5");
+  return text;
+}
+
+sensor_msgs::PointField field(const std::string& name, std::uint32_t offset, std::uint8_t type) {
+  sensor_msgs::PointField f;
+  f.name = name;
+  f.offset = offset;
+  f.datatype = type;
+  f.count = 1;
+  return f;
+}
+
+// An Ouster OS1-64 driver cloud (the first 64 * W points of `cloud`): organized 64 x W, point_step 48 with padding, x y z float32, intensity float32 in
+// the thousands, t uint32 ns, reflectivity uint16, ring uint8.
+sensor_msgs::PointCloud2 ousterCloud(const PointCloud& cloud, const std_msgs::Header& header) {
+  sensor_msgs::PointCloud2 msg;
+  msg.header = header;
+  msg.height = 64;
+  msg.width = static_cast<std::uint32_t>(cloud.size() / 64);
+  msg.fields = {field("x", 0, sensor_msgs::PointField::FLOAT32), field("y", 4, sensor_msgs::PointField::FLOAT32),
+                field("z", 8, sensor_msgs::PointField::FLOAT32),
+                field("intensity", 16, sensor_msgs::PointField::FLOAT32),
+                field("t", 20, sensor_msgs::PointField::UINT32),
+                field("reflectivity", 24, sensor_msgs::PointField::UINT16),
+                field("ring", 26, sensor_msgs::PointField::UINT8)};
+  msg.point_step = 48;
+  msg.row_step = msg.point_step * msg.width;
+  msg.is_dense = false;
+  msg.data.assign(static_cast<std::size_t>(msg.row_step) * msg.height, 0);
+  for (std::size_t i = 0; i < static_cast<std::size_t>(msg.width) * msg.height; ++i) {
+    std::uint8_t* p = msg.data.data() + i * msg.point_step;
+    const Point q = cloud.points[i];
+    const float intensity = q.intensity * 3000.0f;
+    const std::uint32_t t = static_cast<std::uint32_t>(i % 1024) * 97000u;
+    std::memcpy(p + 0, &q.x, 4);
+    std::memcpy(p + 4, &q.y, 4);
+    std::memcpy(p + 8, &q.z, 4);
+    std::memcpy(p + 16, &intensity, 4);
+    std::memcpy(p + 20, &t, 4);
+    p[26] = static_cast<std::uint8_t>(i / msg.width);
+  }
+  return msg;
+}
+
+// x, y, z float32 only.
+sensor_msgs::PointCloud2 xyzCloud(const PointCloud& cloud, const std_msgs::Header& header) {
+  sensor_msgs::PointCloud2 msg;
+  msg.header = header;
+  msg.height = 1;
+  msg.width = static_cast<std::uint32_t>(cloud.size());
+  msg.fields = {field("x", 0, sensor_msgs::PointField::FLOAT32), field("y", 4, sensor_msgs::PointField::FLOAT32),
+                field("z", 8, sensor_msgs::PointField::FLOAT32)};
+  msg.point_step = 12;
+  msg.row_step = 12 * msg.width;
+  msg.is_dense = true;
+  msg.data.resize(msg.row_step);
+  for (std::size_t i = 0; i < cloud.size(); ++i) std::memcpy(msg.data.data() + 12 * i, &cloud.points[i], 12);
+  return msg;
+}
+
+class DetectorNodeletTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_FALSE(source_dir_.empty()) << "RET3D_PACKAGE_DIR not set (test/pipeline_detector_test.test sets it)";
+    std::ofstream(tmp_ / "small.yaml") << smallConfig(source_dir_);
+    DetectorOptions options = loadDetectorOptions(tmp_ / "small.yaml");
+    options.inference.threads = 1;
+    Detector fresh(options);  // empty model path: a freshly initialised network
+    fresh.model().save(tmp_ / "detector.pt");
+    ros::param::set("/ret3d_detector/config", tmp_ / "small.yaml");
+    ros::param::set("/ret3d_detector/model_path", tmp_ / "detector.pt");
+    ros::param::set("/ret3d_detector/threads", 1);
+    seq_.write(tmp_.path(), "0000", 3, /*with_labels=*/false);
+  }
+  void TearDown() override { ros::param::del("/ret3d_detector"); }
+
+  // rostest nodes are not given RET3D_SOURCE_DIR; the .test file passes the package's folder.
+  std::string source_dir_ = std::getenv("RET3D_PACKAGE_DIR") ? std::getenv("RET3D_PACKAGE_DIR") : "";
+  test::TempDir tmp_;
+  test::TinySequence seq_;
+  test::LogCapture log_;
+};
+
+TEST_F(DetectorNodeletTest, EveryCloudGivesDetectionsAndWhatWasDoneIsSaid) {
+  ros::NodeHandle nh;
+  ros::AsyncSpinner spinner(2);
+  spinner.start();
+  nodelet::Loader loader(false);
+  ASSERT_TRUE(test::loadNodelet(loader, "/ret3d_detector", "ret3d/DetectorNodelet")) << log_.all();
+
+  std::mutex mutex;
+  std::vector<ret3d::DetectionArray::ConstPtr> out;
+  ros::Subscriber sub = nh.subscribe<ret3d::DetectionArray>(
+      "/detections", 100, [&](const ret3d::DetectionArray::ConstPtr& m) {
+        std::lock_guard<std::mutex> lock(mutex);
+        out.push_back(m);
+      });
+  ros::Publisher points = nh.advertise<sensor_msgs::PointCloud2>("/points", 10);
+  ros::Publisher tf = nh.advertise<tf2_msgs::TFMessage>("/tf", 100);
+  ASSERT_TRUE(test::waitFor(
+      [&] { return points.getNumSubscribers() > 0 && sub.getNumPublishers() > 0 && tf.getNumSubscribers() > 0; },
+      10.0));
+
+  double t = 1.0e9;
+  // odom -> velodyne at t: driving forward 1 m per 0.1 s.
+  auto publishTf = [&](double stamp, double x) {
+    tf2_msgs::TFMessage m;
+    geometry_msgs::TransformStamped ts;
+    ts.header.stamp = ros::Time(stamp);
+    ts.header.frame_id = "odom";
+    ts.child_frame_id = "velodyne";
+    ts.transform.translation.x = x;
+    ts.transform.rotation.w = 1.0;
+    m.transforms.push_back(ts);
+    tf.publish(m);
+  };
+  std::size_t sent = 0;
+  auto send = [&](const sensor_msgs::PointCloud2& cloud, const std::string& what) {
+    const std::size_t before = [&] {
+      std::lock_guard<std::mutex> lock(mutex);
+      return out.size();
+    }();
+    points.publish(boost::make_shared<sensor_msgs::PointCloud2>(cloud));
+    ++sent;
+    const bool ok = test::waitFor(
+        [&] {
+          std::lock_guard<std::mutex> lock(mutex);
+          return out.size() > before;
+        },
+        30.0);
+    EXPECT_TRUE(ok) << "no detections for the " << what << " cloud\n" << log_.all();
+    std::lock_guard<std::mutex> lock(mutex);
+    if (ok) {
+      EXPECT_EQ(out.back()->header.stamp, cloud.header.stamp) << what;
+      EXPECT_EQ(out.back()->header.frame_id, cloud.header.frame_id) << what;
+      EXPECT_EQ(out.back()->features.size(), out.back()->objects.size() * out.back()->feature_dim) << what;
+    }
+  };
+  std_msgs::Header h;
+  h.frame_id = "velodyne";
+
+  // Two velodyne-layout sweeps with tf: the second uses the first, motion-compensated.
+  for (int f = 0; f < 2; ++f) {
+    h.stamp = ros::Time(t += 0.1);
+    publishTf(h.stamp.toSec(), 1.0 * f);
+    ros::WallDuration(0.05).sleep();
+    send(toPointCloud2(seq_.scans[f], h), "velodyne");
+  }
+  // Ouster layout.
+  h.stamp = ros::Time(t += 0.1);
+  publishTf(h.stamp.toSec(), 2.0);
+  ros::WallDuration(0.05).sleep();
+  send(ousterCloud(seq_.scans[2], h), "Ouster");
+  // No intensity.
+  h.stamp = ros::Time(t += 0.1);
+  publishTf(h.stamp.toSec(), 3.0);
+  send(xyzCloud(seq_.scans[0], h), "no-intensity");
+  EXPECT_FALSE(log_.find({"no intensity field"}).empty()) << log_.all();
+  // Empty.
+  h.stamp = ros::Time(t += 0.1);
+  publishTf(h.stamp.toSec(), 4.0);
+  send(toPointCloud2(PointCloud(), h), "empty");
+  EXPECT_FALSE(log_.find({"empty cloud"}).empty()) << log_.all();
+  // All NaN.
+  PointCloud nan_cloud;
+  for (int i = 0; i < 1000; ++i) {
+    nan_cloud.points.push_back({std::nanf(""), std::nanf(""), std::nanf(""), 0.5f});
+  }
+  h.stamp = ros::Time(t += 0.1);
+  publishTf(h.stamp.toSec(), 5.0);
+  send(toPointCloud2(nan_cloud, h), "NaN");
+  EXPECT_FALSE(log_.find({"dropped 1000 of 1000 points", "NaN"}).empty()) << log_.all();
+  // A million points.
+  PointCloud big;
+  big.points.reserve(1000000);
+  for (int i = 0; i < 1000000; ++i) {
+    const double a = i * 0.000628, r = 3.0 + (i % 2000) * 0.01;
+    big.points.push_back({static_cast<float>(r * std::cos(a)), static_cast<float>(r * std::sin(a)),
+                          static_cast<float>(-1.7 + 0.001 * (i % 3000)), 0.3f});
+  }
+  h.stamp = ros::Time(t += 0.1);
+  publishTf(h.stamp.toSec(), 6.0);
+  send(toPointCloud2(big, h), "1-million-point");
+  // Stamps going backwards.
+  h.stamp = ros::Time(t - 0.35);
+  publishTf(h.stamp.toSec(), 2.5);
+  send(toPointCloud2(seq_.scans[1], h), "backwards");
+  EXPECT_FALSE(log_.find({"stamp went backwards"}).empty()) << log_.all();
+  // A frame tf does not know, two sweeps in a row: no motion compensation, and said so.
+  h.frame_id = "lidar_without_tf";
+  for (int f = 0; f < 2; ++f) {
+    h.stamp = ros::Time(t += 0.1);
+    send(toPointCloud2(seq_.scans[f], h), "untransformed");
+  }
+  EXPECT_FALSE(log_.find({"no transform", "lidar_without_tf", "without motion compensation"}).empty()) << log_.all();
+  std::lock_guard<std::mutex> lock(mutex);
+  EXPECT_EQ(out.size(), sent);
+}
+
+TEST_F(DetectorNodeletTest, ModelThatDoesNotFitTheConfigIsRefused) {
+  // The saved model is for the small grid; the default config describes another one.
+  ros::param::set("/bad_detector/model_path", tmp_ / "detector.pt");
+  ros::param::set("/bad_detector/config", source_dir_ + "/config/detector/lwd3d_center.yaml");
+  nodelet::Loader loader(false);
+  EXPECT_FALSE(test::loadNodelet(loader, "/bad_detector", "ret3d/DetectorNodelet"));
+  EXPECT_FALSE(log_.find({"refuses to start", "/bad_detector/model_path", "detector.pt"}).empty()) << log_.all();
+  ros::param::del("/bad_detector");
+}
+
+TEST_F(DetectorNodeletTest, MissingModelIsRefused) {
+  ros::param::set("/bad_detector/model_path", tmp_ / "missing.pt");
+  ros::param::set("/bad_detector/config", tmp_ / "small.yaml");
+  nodelet::Loader loader(false);
+  EXPECT_FALSE(test::loadNodelet(loader, "/bad_detector", "ret3d/DetectorNodelet"));
+  EXPECT_FALSE(log_.find({"refuses to start", "/bad_detector/model_path", "missing.pt"}).empty()) << log_.all();
+  ros::param::del("/bad_detector");
+}
+
+}  // namespace
+}  // namespace ret3d
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "pipeline_detector_test");
+  ros::NodeHandle nh;
+  return RUN_ALL_TESTS();
+}
