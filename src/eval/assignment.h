@@ -1,6 +1,5 @@
 // Internal to src/eval: the optimal one-to-one assignment that TrackEval's CLEAR and HOTA take from
-// scipy.optimize.linear_sum_assignment. src/eval may not depend on src/tracking (ARCHITECTURE.md), which has its own
-// solver for the tracker; this one maximises a score and is small enough to keep here.
+// scipy.optimize.linear_sum_assignment, as a maximisation over the core solver (ret3d/core/hungarian.h).
 #pragma once
 
 #include <vector>

@@ -7,7 +7,7 @@
 
 #include "ret3d/core/log.h"
 #include "ret3d/core/transform.h"
-#include "ret3d/tracking/hungarian.h"
+#include "ret3d/core/hungarian.h"
 
 namespace ret3d {
 

@@ -1,4 +1,4 @@
-#include "ret3d/tracking/hungarian.h"
+#include "ret3d/core/hungarian.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,5 @@
-// Optimal assignment (Hungarian / Kuhn-Munkres with potentials, O(n^2 m)) for the tracker's optional matcher.
+// Optimal assignment (Hungarian / Kuhn-Munkres with potentials, O(n^2 m)): the tracker's optional matcher and the
+// one-to-one matching of the tracking metrics (CLEAR MOT, HOTA).
 #pragma once
 
 #include <vector>
