@@ -17,10 +17,6 @@
 #include "ret3d/ros/conversions.h"
 #include "ret3d/ros/kitti_bag.h"
 #include "ros/tiny_sequence.h"
-// rostest nodes are not given RET3D_SOURCE_DIR (test_util.h's shared-data lookup uses it); this node needs TempDir.
-#ifndef RET3D_SOURCE_DIR
-#define RET3D_SOURCE_DIR ""
-#endif
 #include "test_util.h"
 
 extern char** environ;

@@ -23,9 +23,6 @@
 #include "ret3d/detector/nn/model.h"
 #include "ret3d/ros/conversions.h"
 #include "ros/tiny_sequence.h"
-#ifndef RET3D_SOURCE_DIR
-#define RET3D_SOURCE_DIR ""
-#endif
 #include "test_util.h"
 
 namespace ret3d {

@@ -21,9 +21,6 @@
 #include "ret3d/ros/bag_objects.h"
 #include "ret3d/ros/kitti_bag.h"
 #include "ros/tiny_sequence.h"
-#ifndef RET3D_SOURCE_DIR
-#define RET3D_SOURCE_DIR ""
-#endif
 #include "test_util.h"
 
 namespace ret3d {

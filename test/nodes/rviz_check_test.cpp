@@ -17,9 +17,6 @@
 #include "ret3d/ros/conversions.h"
 #include "ret3d/ros/markers.h"
 #include "ros/tiny_sequence.h"
-#ifndef RET3D_SOURCE_DIR
-#define RET3D_SOURCE_DIR ""
-#endif
 #include "test_util.h"
 
 namespace ret3d {
