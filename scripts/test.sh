@@ -5,7 +5,10 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$(pwd)
 scripts/setup.sh
+# ROS's setup scripts read unset variables: source them without nounset.
+set +u
 source scripts/env.sh
+set -u
 # Keep ROS logs and any roscore state of the tests out of the user's home.
 export ROS_HOME="$ROOT/build/ros_home"
 export ROS_LOG_DIR="$ROS_HOME/log"
