@@ -6,6 +6,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "config_reader.h"
+
 #include "ret3d/relation/inter_rm.h"
 
 namespace ret3d {
@@ -13,40 +15,11 @@ namespace relation {
 
 namespace {
 
-[[noreturn]] void fail(const std::string& source, const std::string& what) {
-  throw std::invalid_argument("InterRM config " + source + ": " + what);
-}
-
-void checkKeys(const YAML::Node& node, const std::set<std::string>& allowed, const std::string& source,
-               const std::string& section) {
-  if (!node.IsMap()) fail(source, "'" + section + "' must be a mapping");
-  for (const auto& kv : node) {
-    const std::string key = kv.first.as<std::string>();
-    if (!allowed.count(key)) {
-      std::string list;
-      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-      fail(source, "unknown key '" + section + "." + key + "' (line " + std::to_string(kv.first.Mark().line + 1) +
-                       "; known: " + list + ")");
-    }
-  }
-}
-
-template <typename T>
-void read(const YAML::Node& node, const char* key, T* value, const std::string& source, const std::string& section) {
-  if (!node[key]) return;
-  try {
-    *value = node[key].as<T>();
-  } catch (const YAML::Exception&) {
-    fail(source, "'" + section + "." + key + "' (line " + std::to_string(node[key].Mark().line + 1) +
-                     ") is not a valid value");
-  }
-}
-
-InterPositionalEncoding parsePe(const std::string& s, const std::string& source) {
+InterPositionalEncoding parsePe(const std::string& s, const detail::ConfigReader& r) {
   if (s == "implicit") return InterPositionalEncoding::Implicit;
   if (s == "temporal") return InterPositionalEncoding::Temporal;
   if (s == "spatial") return InterPositionalEncoding::Spatial;
-  fail(source, "'model.positional_encoding' is '" + s + "' (allowed: implicit, temporal, spatial)");
+  r.fail("'model.positional_encoding' is '" + s + "' (allowed: implicit, temporal, spatial)");
 }
 
 }  // namespace
@@ -82,68 +55,46 @@ void InterRMTrainConfig::validate() const {
 }
 
 InterRMConfig parseInterRMConfig(const std::string& yaml_text, const std::string& source) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error("InterRM config " + source + ": not valid YAML: " + e.what());
-  }
+  const detail::ConfigReader r("InterRM", source);
+  const YAML::Node root = r.load(yaml_text);
   InterRMConfig c;
   if (root.IsNull()) return c;
-  checkKeys(root, {"model", "train"}, source, "<top>");
+  r.checkKeys(root, {"model", "train"}, "<top>");
   if (const YAML::Node m = root["model"]) {
-    checkKeys(m, {"c_enc", "heads", "ffn_expansion", "positional_encoding", "max_history", "regress_size"}, source,
-              "model");
-    read(m, "regress_size", &c.model.regress_size, source, "model");
-    read(m, "c_enc", &c.model.c_enc, source, "model");
-    read(m, "heads", &c.model.heads, source, "model");
-    read(m, "ffn_expansion", &c.model.ffn_expansion, source, "model");
+    r.checkKeys(m, {"c_enc", "heads", "ffn_expansion", "positional_encoding", "max_history", "regress_size"}, "model");
+    r.read(m, "regress_size", &c.model.regress_size, "model");
+    r.read(m, "c_enc", &c.model.c_enc, "model");
+    r.read(m, "heads", &c.model.heads, "model");
+    r.read(m, "ffn_expansion", &c.model.ffn_expansion, "model");
     std::string pe = positionalEncodingName(c.model.positional_encoding);
-    read(m, "positional_encoding", &pe, source, "model");
-    c.model.positional_encoding = parsePe(pe, source);
-    read(m, "max_history", &c.model.max_history, source, "model");
+    r.read(m, "positional_encoding", &pe, "model");
+    c.model.positional_encoding = parsePe(pe, r);
+    r.read(m, "max_history", &c.model.max_history, "model");
   }
   if (const YAML::Node t = root["train"]) {
-    checkKeys(t,
+    r.checkKeys(t,
               {"lr", "weight_decay", "sequences_per_batch", "epochs", "smooth_l1_beta", "reg_min_iou", "augment_flip",
-               "seed"},
-              source, "train");
-    read(t, "lr", &c.train.lr, source, "train");
-    read(t, "weight_decay", &c.train.weight_decay, source, "train");
-    read(t, "sequences_per_batch", &c.train.sequences_per_batch, source, "train");
-    read(t, "epochs", &c.train.epochs, source, "train");
-    read(t, "smooth_l1_beta", &c.train.smooth_l1_beta, source, "train");
-    read(t, "augment_flip", &c.train.augment_flip, source, "train");
-    read(t, "seed", &c.train.seed, source, "train");
-    if (const YAML::Node r = t["reg_min_iou"]) {
-      if (!r.IsMap()) fail(source, "'train.reg_min_iou' must map Car/Pedestrian/Cyclist to numbers");
-      for (const auto& kv : r) {
-        const std::string name = kv.first.as<std::string>();
-        const auto cls = classFromName(name);
-        if (!cls) fail(source, "'train.reg_min_iou' has unknown class '" + name + "'");
-        try {
-          c.train.reg_min_iou[static_cast<int>(*cls) - 1] = kv.second.as<double>();
-        } catch (const YAML::Exception&) {
-          fail(source, "'train.reg_min_iou." + name + "' is not a number");
-        }
-      }
-    }
+               "seed"}, "train");
+    r.read(t, "lr", &c.train.lr, "train");
+    r.read(t, "weight_decay", &c.train.weight_decay, "train");
+    r.read(t, "sequences_per_batch", &c.train.sequences_per_batch, "train");
+    r.read(t, "epochs", &c.train.epochs, "train");
+    r.read(t, "smooth_l1_beta", &c.train.smooth_l1_beta, "train");
+    r.read(t, "augment_flip", &c.train.augment_flip, "train");
+    r.read(t, "seed", &c.train.seed, "train");
+    r.readPerClass(t, "reg_min_iou", &c.train.reg_min_iou, "train");
   }
   try {
     c.model.validate();
     c.train.validate();
   } catch (const std::invalid_argument& e) {
-    fail(source, e.what());
+    r.fail(e.what());
   }
   return c;
 }
 
 InterRMConfig loadInterRMConfig(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error("InterRM config " + path + ": cannot be read");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parseInterRMConfig(ss.str(), path);
+  return parseInterRMConfig(detail::readConfigFile("InterRM", path), path);
 }
 
 std::string toYaml(const InterRMConfig& c) {

@@ -8,58 +8,12 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "config_reader.h"
+
 #include "ret3d/core/types.h"
 
 namespace ret3d {
 namespace relation {
-
-namespace {
-
-[[noreturn]] void fail(const std::string& source, const std::string& what) {
-  throw std::invalid_argument("IntraRM config " + source + ": " + what);
-}
-
-void checkKeys(const YAML::Node& node, const std::set<std::string>& allowed, const std::string& source,
-               const std::string& section) {
-  if (!node.IsMap()) fail(source, "'" + section + "' must be a mapping");
-  for (const auto& kv : node) {
-    const std::string key = kv.first.as<std::string>();
-    if (!allowed.count(key)) {
-      std::string list;
-      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-      fail(source, "unknown key '" + section + "." + key + "' (known: " + list + ")");
-    }
-  }
-}
-
-template <typename T>
-void read(const YAML::Node& node, const char* key, T* value, const std::string& source, const std::string& section) {
-  if (!node[key]) return;
-  try {
-    *value = node[key].as<T>();
-  } catch (const YAML::Exception&) {
-    fail(source, "'" + section + "." + key + "' (line " + std::to_string(node[key].Mark().line + 1) +
-                     ") is not a valid value");
-  }
-}
-
-void readPerClass(const YAML::Node& node, const char* key, PerClass* value, const std::string& source) {
-  if (!node[key]) return;
-  const YAML::Node n = node[key];
-  if (!n.IsMap()) fail(source, std::string("'train.") + key + "' must map Car/Pedestrian/Cyclist to numbers");
-  for (const auto& kv : n) {
-    const std::string name = kv.first.as<std::string>();
-    const auto cls = classFromName(name);
-    if (!cls) fail(source, std::string("'train.") + key + "' has unknown class '" + name + "'");
-    try {
-      (*value)[static_cast<int>(*cls) - 1] = kv.second.as<double>();
-    } catch (const YAML::Exception&) {
-      fail(source, std::string("'train.") + key + "." + name + "' is not a number");
-    }
-  }
-}
-
-}  // namespace
 
 void IntraRMArch::validate() const {
   if (hidden < 1) throw std::invalid_argument("IntraRM model.hidden must be >= 1, got " + std::to_string(hidden));
@@ -86,60 +40,50 @@ void IntraRMTrainConfig::validate() const {
 }
 
 IntraRMConfig parseIntraRMConfig(const std::string& yaml_text, const std::string& source) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& e) {
-    fail(source, std::string("not valid YAML: ") + e.what());
-  }
+  const detail::ConfigReader r("IntraRM", source);
+  const YAML::Node root = r.load(yaml_text);
   IntraRMConfig c;
   if (root.IsNull()) return c;
-  checkKeys(root, {"model", "train"}, source, "<top>");
+  r.checkKeys(root, {"model", "train"}, "<top>");
   if (const YAML::Node m = root["model"]) {
-    checkKeys(m, {"feature_dim", "hidden", "rounds", "radius", "use_edges", "head_hidden", "refine_boxes"}, source,
-              "model");
-    read(m, "feature_dim", &c.model.feature_dim, source, "model");
-    read(m, "hidden", &c.model.hidden, source, "model");
-    read(m, "rounds", &c.model.rounds, source, "model");
-    read(m, "radius", &c.model.radius, source, "model");
-    read(m, "use_edges", &c.model.use_edges, source, "model");
-    read(m, "head_hidden", &c.model.head_hidden, source, "model");
-    read(m, "refine_boxes", &c.model.refine_boxes, source, "model");
+    r.checkKeys(m, {"feature_dim", "hidden", "rounds", "radius", "use_edges", "head_hidden", "refine_boxes"}, "model");
+    r.read(m, "feature_dim", &c.model.feature_dim, "model");
+    r.read(m, "hidden", &c.model.hidden, "model");
+    r.read(m, "rounds", &c.model.rounds, "model");
+    r.read(m, "radius", &c.model.radius, "model");
+    r.read(m, "use_edges", &c.model.use_edges, "model");
+    r.read(m, "head_hidden", &c.model.head_hidden, "model");
+    r.read(m, "refine_boxes", &c.model.refine_boxes, "model");
   }
   if (const YAML::Node t = root["train"]) {
-    checkKeys(t,
+    r.checkKeys(t,
               {"lr", "weight_decay", "frames_per_batch", "epochs", "loc_weight", "dir_weight", "focal_alpha",
-               "focal_gamma", "cls_pos_iou", "reg_min_iou", "augment_flip", "augment_rotation", "seed"},
-              source, "train");
-    read(t, "lr", &c.train.lr, source, "train");
-    read(t, "weight_decay", &c.train.weight_decay, source, "train");
-    read(t, "frames_per_batch", &c.train.frames_per_batch, source, "train");
-    read(t, "epochs", &c.train.epochs, source, "train");
-    read(t, "loc_weight", &c.train.loc_weight, source, "train");
-    read(t, "dir_weight", &c.train.dir_weight, source, "train");
-    read(t, "focal_alpha", &c.train.focal_alpha, source, "train");
-    read(t, "focal_gamma", &c.train.focal_gamma, source, "train");
-    readPerClass(t, "cls_pos_iou", &c.train.cls_pos_iou, source);
-    readPerClass(t, "reg_min_iou", &c.train.reg_min_iou, source);
-    read(t, "augment_flip", &c.train.augment_flip, source, "train");
-    read(t, "augment_rotation", &c.train.augment_rotation, source, "train");
-    read(t, "seed", &c.train.seed, source, "train");
+               "focal_gamma", "cls_pos_iou", "reg_min_iou", "augment_flip", "augment_rotation", "seed"}, "train");
+    r.read(t, "lr", &c.train.lr, "train");
+    r.read(t, "weight_decay", &c.train.weight_decay, "train");
+    r.read(t, "frames_per_batch", &c.train.frames_per_batch, "train");
+    r.read(t, "epochs", &c.train.epochs, "train");
+    r.read(t, "loc_weight", &c.train.loc_weight, "train");
+    r.read(t, "dir_weight", &c.train.dir_weight, "train");
+    r.read(t, "focal_alpha", &c.train.focal_alpha, "train");
+    r.read(t, "focal_gamma", &c.train.focal_gamma, "train");
+    r.readPerClass(t, "cls_pos_iou", &c.train.cls_pos_iou, "train");
+    r.readPerClass(t, "reg_min_iou", &c.train.reg_min_iou, "train");
+    r.read(t, "augment_flip", &c.train.augment_flip, "train");
+    r.read(t, "augment_rotation", &c.train.augment_rotation, "train");
+    r.read(t, "seed", &c.train.seed, "train");
   }
   try {
     c.model.validate();
     c.train.validate();
   } catch (const std::invalid_argument& e) {
-    fail(source, e.what());
+    r.fail(e.what());
   }
   return c;
 }
 
 IntraRMConfig loadIntraRMConfig(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error("IntraRM config " + path + ": cannot open");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parseIntraRMConfig(ss.str(), path);
+  return parseIntraRMConfig(detail::readConfigFile("IntraRM", path), path);
 }
 
 std::string toYaml(const IntraRMConfig& c) {
