@@ -28,6 +28,19 @@ struct CommandInfo {
 
 std::vector<CommandInfo>& commandRegistry();
 
+// The command as the user gave it ("ret3d train intra --data D --out M ..."), from the options CLI11 parsed: model
+// files record it as their provenance.
+inline std::string commandLine(const std::string& command, const CLI::App& app) {
+  std::string line = command;
+  for (const CLI::Option* o : app.get_options()) {
+    if (o->count() == 0 || o->get_name() == "--help") continue;
+    line += " " + o->get_name();
+    if (o->get_type_size_max() == 0) continue;  // a flag
+    for (const auto& r : o->results()) line += " " + r;
+  }
+  return line;
+}
+
 struct CommandRegistrar {
   CommandRegistrar(std::string name, std::string description, CommandSetup setup) {
     commandRegistry().push_back({std::move(name), std::move(description), std::move(setup)});

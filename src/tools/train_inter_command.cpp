@@ -1,6 +1,6 @@
-// `ret3d train-inter`: trains InterRM (Ret3D §3.3) on tracked sequences built by running the tracker (optionally after
+// `ret3d train inter`: trains InterRM (Ret3D §3.3) on tracked sequences built by running the tracker (optionally after
 // IntraRM) over another detector's boxes with the real ego poses, or prints a model's metadata.
-//   ret3d train-inter --data ../shared/data/kitti_tracking --detections ../shared/data/kitti_tracking/detections/pointrcnn
+//   ret3d train inter --data ../shared/data/kitti_tracking --detections ../shared/data/kitti_tracking/detections/pointrcnn
 //                     --intra-model models/kitti_pointrcnn/intra_rm.pt --sequences 1-15 --out models/kitti_pointrcnn/inter_rm.pt
 #include <iostream>
 #include <memory>
@@ -12,7 +12,7 @@
 #include "ret3d/relation/intra_rm.h"
 #include "ret3d/train/inter_trainer.h"
 #include "ret3d/tracking/tracker_options.h"
-#include "tools/command.h"
+#include "tools/train_command.h"
 
 namespace ret3d {
 namespace tools {
@@ -75,8 +75,8 @@ int runTrainInter(const TrainInterArgs& a) {
   return 0;
 }
 
-CommandRegistrar reg("train-inter", "train InterRM (Ret3D inter-frame relation module) on tracked detections",
-                     [](CLI::App& app) -> CommandRun {
+TrainRegistrar reg("inter", "InterRM (Ret3D inter-frame relation module) on tracked detections",
+                   [](CLI::App& app) -> CommandRun {
   auto a = std::make_shared<TrainInterArgs>();
   app.add_option("--data", a->data, "KITTI tracking root with labels, calibration and poses (pose/ or oxts/)");
   app.add_option("--detections", a->detections,
@@ -94,15 +94,7 @@ CommandRegistrar reg("train-inter", "train InterRM (Ret3D inter-frame relation m
   app.add_flag("--quiet", a->quiet, "no progress bar");
   app.add_option("--inspect", a->inspect, "print a model file's metadata and exit");
   return [a, &app]() {
-    std::ostringstream cmd;
-    cmd << "ret3d train-inter";
-    for (const auto* o : app.get_options()) {
-      if (o->count() == 0 || o->get_name() == "--help") continue;
-      cmd << " " << o->get_name();
-      if (o->get_type_size_max() == 0) continue;  // a flag
-      for (const auto& r : o->results()) cmd << " " << r;
-    }
-    a->command_line = cmd.str();
+    a->command_line = commandLine("ret3d train inter", app);
     return runTrainInter(*a);
   };
 });

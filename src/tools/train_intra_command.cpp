@@ -88,15 +88,7 @@ TrainRegistrar reg("intra", "IntraRM (Ret3D intra-frame relation module) on anot
   app.add_flag("--quiet", a->quiet, "no progress bar");
   app.add_option("--inspect", a->inspect, "print a model file's metadata and exit");
   return [a, &app]() {
-    std::ostringstream cmd;
-    cmd << "ret3d train intra";
-    for (const auto* o : app.get_options()) {
-      if (o->count() == 0 || o->get_name() == "--help") continue;
-      cmd << " " << o->get_name();
-      if (o->get_type_size_max() == 0) continue;  // a flag
-      for (const auto& r : o->results()) cmd << " " << r;
-    }
-    a->command_line = cmd.str();
+    a->command_line = commandLine("ret3d train intra", app);
     return runTrainIntra(*a);
   };
 });

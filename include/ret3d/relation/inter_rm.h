@@ -81,7 +81,7 @@ struct InterRMSequence {
 };
 
 struct InterRMOptions {
-  std::string model_path;  // a model file written by `ret3d train-inter` (or InterRM::save)
+  std::string model_path;  // a model file written by `ret3d train inter` (or InterRM::save)
   // Optional expectations checked against the model file (a mismatch is refused, saying what differs):
   int c_enc = -1;                  // < 0: any
   std::string positional_encoding; // empty: any; else "implicit", "temporal" or "spatial"
