@@ -52,7 +52,9 @@ void ProgressBar::draw(bool force) {
                  total_, rate, eta_s / 60, eta_s % 60, info_.c_str());
   } else {
     const int decile = static_cast<int>(frac * 10);
-    if (decile == last_decile_ && !(force && done_ >= total_ && last_decile_ < 10)) return;
+    // Each tenth, and at least once a minute for long jobs (training) whose tenths are far apart.
+    const bool minute = now - last_draw_ >= std::chrono::seconds(60);
+    if (decile == last_decile_ && !minute && !(force && done_ >= total_ && last_decile_ < 10)) return;
     last_decile_ = decile;
     std::fprintf(stderr, "%s %3d%% %zu/%zu  %.1f it/s  %s\n", label_.c_str(), static_cast<int>(frac * 100), done_,
                  total_, rate, info_.c_str());

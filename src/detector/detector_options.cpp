@@ -185,6 +185,8 @@ void readTrain(MapReader r, TrainOptions* t) {
   r.get("multiscale_base", &t->multiscale_base);
   r.get("multiscale_n_min", &t->multiscale_n_min);
   r.get("multiscale_n_max", &t->multiscale_n_max);
+  r.get("multiscale_random_position", &t->multiscale_random_position);
+  r.get("threads", &t->threads);
   r.get("supervised_fov_deg", &t->supervised_fov_deg);
   r.get("loss_weight_regression", &t->loss_weight_regression);
   r.get("loss_weight_velocity", &t->loss_weight_velocity);

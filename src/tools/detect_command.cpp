@@ -1,12 +1,15 @@
-// `ret3d detect`: runs the detection stages offline and writes KITTI result files.
-//   ret3d detect --detections DIR --stages intra --intra-model models/kitti_pointrcnn/intra_rm.pt
-//                --data ../shared/data/kitti_tracking --sequences 16-20 --out out/pred_intra
-// The input boxes come from another detector's result files (--detections: KITTI object/tracking result files or
-// the per-class CSV layout); `--stages` lists what runs on them, in order: "intra" (IntraRM) or "none" (the boxes
-// pass through the same conversions, the fair baseline). The base detector stage ("base") runs on point clouds and
-// joins here when the detector is built. "track" runs the tracker (CenterPoint's, real ego poses) and writes track ids;
-// "inter" runs the tracker and InterRM on every tracked box (train/inter_trainer.h: TrackingRefiner).
-#include <chrono>
+// `ret3d detect`: runs the pipeline offline over a KITTI-layout folder and writes KITTI result files: one per frame
+// for the object layout, one per sequence (tracking result format, with track ids after `track`/`inter`) for the
+// tracking layout.
+//   ret3d detect --data data/sim_test_urban --models models/lwd3d --out out/pred --stages base
+//   ret3d detect --detections ../shared/data/kitti_tracking/detections/pointrcnn --stages intra \
+//                --intra-model models/kitti_pointrcnn/intra_rm.pt --data ../shared/data/kitti_tracking \
+//                --sequences 16-20 --out out/pred_intra
+// With the `base` stage the boxes come from the LWD-3D detector on the folder's scans (the previous sweep moved by
+// the ego motion of pose/ or oxts/); without it they come from another detector's result files (--detections:
+// KITTI object/tracking result files or the per-class CSV layout). `--stages` lists what runs, in order:
+// base, intra (IntraRM), track (the CenterPoint-style tracker, real ego poses), inter (tracker + InterRM), or none
+// (the boxes pass through the same conversions: the fair baseline).
 #include <filesystem>
 #include <iostream>
 #include <map>
@@ -18,11 +21,8 @@
 #include "ret3d/eval/eval_data.h"
 #include "ret3d/io/detections.h"
 #include "ret3d/io/kitti.h"
-#include "ret3d/relation/inter_rm.h"
-#include "ret3d/relation/intra_rm.h"
-#include "ret3d/train/inter_trainer.h"
-#include "ret3d/tracking/tracker_options.h"
 #include "tools/command.h"
+#include "tools/offline_pipeline.h"
 
 namespace ret3d {
 namespace tools {
@@ -31,37 +31,8 @@ namespace {
 namespace fs = std::filesystem;
 
 struct DetectArgs {
-  std::string data, detections, out, stages = "intra", intra_model, sequences, inter_model, tracker_config;
-  int threads = 2;
-};
-
-std::vector<std::string> splitStages(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    if (item.empty() || item == "none") continue;
-    if (item != "intra" && item != "base" && item != "track" && item != "inter")
-      throw std::runtime_error("--stages: unknown stage '" + item + "' (known: base, intra, track, inter, none)");
-    out.push_back(item);
-  }
-  return out;
-}
-
-// The stages after the base detector, applied to one frame.
-struct Stages {
-  std::unique_ptr<relation::IntraRM> intra;
-  std::unique_ptr<relation::InterRM> inter;
-  std::unique_ptr<train::TrackingRefiner> tracking;  // stages track / inter: after the per-frame stages
-  double seconds = 0;
-  std::size_t frames = 0;
-  Detections run(Detections d) {
-    const auto t0 = std::chrono::steady_clock::now();
-    if (intra) d = intra->refine(d);
-    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    ++frames;
-    return d;
-  }
+  PipelineConfig pipeline;
+  std::string data, detections, out, stages = "base", sequences;
 };
 
 Detections toDetections(const std::vector<kitti::Label>& labels, const kitti::Calibration& calib) {
@@ -81,117 +52,178 @@ std::vector<kitti::Label> toLabels(const Detections& d, const kitti::Calibration
   return out;
 }
 
-int runDetect(const DetectArgs& a) {
-  const std::vector<std::string> stages = splitStages(a.stages);
-  if (a.detections.empty())
-    throw std::runtime_error("--detections DIR is required: the base detector stage on point clouds is not "
-                             "available in this build yet");
-  Stages st;
-  for (const std::string& s : stages) {
-    if (s == "base")
-      throw std::runtime_error("--stages base: the input boxes come from --detections; drop 'base' from --stages");
-    if (s == "intra") {
-      if (a.intra_model.empty()) throw std::runtime_error("--stages intra needs --intra-model FILE");
-      relation::IntraRMOptions o;
-      o.model_path = a.intra_model;
-      o.threads = a.threads;
-      st.intra = std::make_unique<relation::IntraRM>(o);
-    }
-    if (s == "inter") {
-      if (a.inter_model.empty()) throw std::runtime_error("--stages inter needs --inter-model FILE");
-      relation::InterRMOptions o;
-      o.model_path = a.inter_model;
-      o.threads = a.threads;
-      st.inter = std::make_unique<relation::InterRM>(o);
-    }
-    if (s == "track" || s == "inter") {
-      if (stages.back() != s) throw std::runtime_error("--stages: '" + s + "' must be the last stage");
-      const TrackerOptions t = a.tracker_config.empty() ? TrackerOptions{} : loadTrackerOptions(a.tracker_config);
-      st.tracking = std::make_unique<train::TrackingRefiner>(t, st.inter.get());
-    }
+// True when ROOT (or ROOT/training) holds velodyne/FFFFFF.bin files directly: the object layout.
+bool isObjectLayout(const std::string& root) {
+  for (const fs::path dir : {fs::path(root) / "training" / "velodyne", fs::path(root) / "velodyne"}) {
+    if (!fs::is_directory(dir)) continue;
+    for (const auto& e : fs::directory_iterator(dir))
+      if (e.is_regular_file() && e.path().extension() == ".bin") return true;
+    return false;
   }
-  if (a.data.empty() || a.out.empty()) throw std::runtime_error("--data and --out are required");
-  fs::create_directories(a.out);
-  const io::DetectionLayout layout = io::detectDetectionLayout(a.detections);
+  return false;
+}
+
+// The base detector on a KITTI-layout folder's scans.
+std::size_t detectFromScans(const DetectArgs& a, OfflinePipeline* p) {
   std::size_t boxes = 0;
-  if (layout == io::DetectionLayout::KittiObject && st.tracking)
-    throw std::runtime_error("--stages track/inter need sequences: " + a.detections + " holds per-frame object results");
-  if (layout == io::DetectionLayout::KittiObject) {
+  if (isObjectLayout(a.data)) {
+    if (p->tracks()) throw std::runtime_error("--stages track/inter need sequences: " + a.data + " has the object layout");
     kitti::ObjectDataset ds(a.data);
     const auto frames = ds.frames();
     ProgressBar bar("detect", frames.size());
     for (const std::string& fr : frames) {
       const kitti::Calibration calib = kitti::readCalibration(ds.calibPath(fr));
-      const Detections d = st.run(toDetections(io::readFrameDetections(a.detections, fr), calib));
+      const PointCloud cloud = kitti::readVelodyne(ds.velodynePath(fr));
+      const Detections d = p->run(&cloud, nullptr, Eigen::Isometry3d::Identity(), {}, 0.0, Eigen::Isometry3d::Identity());
       boxes += d.size();
       kitti::writeObjectLabels(a.out + "/" + fr + ".txt", toLabels(d, calib, -1));
       bar.tick();
     }
-  } else {
-    kitti::TrackingDataset ds(a.data);
-    std::vector<std::string> seqs =
-        a.sequences.empty() ? ds.sequences() : eval::parseSequenceList(a.sequences);
-    ProgressBar bar("detect", seqs.size());
-    for (const std::string& seq : seqs) {
-      const kitti::Calibration calib = kitti::readCalibration(ds.calibPath(seq));
-      std::vector<kitti::Label> out;
-      const auto dets = io::readSequenceDetections(a.detections, layout, seq);
-      if (st.tracking) {
-        // Every frame in order (frames without detections too: tracks coast), at 10 Hz, with the real ego poses.
-        const auto poses = ds.lidarPoses(seq);
-        if (poses.empty()) throw std::runtime_error("sequence " + seq + ": no ego poses (pose/ or oxts/) for tracking");
-        if (!dets.empty() && dets.rbegin()->first >= static_cast<int>(poses.size()))
-          throw std::runtime_error("sequence " + seq + ": detections in frame " +
-                                   std::to_string(dets.rbegin()->first) + " beyond its " +
-                                   std::to_string(poses.size()) + " poses");
-        st.tracking->reset();
-        for (int frame = 0; frame < static_cast<int>(poses.size()); ++frame) {
-          const auto it = dets.find(frame);
-          Detections d = st.run(it == dets.end() ? Detections{} : toDetections(it->second, calib));
-          d.boxes = st.tracking->update(d.boxes, 0.1 * frame, poses[static_cast<std::size_t>(frame)]);
-          d.features.clear(), d.feature_dim = 0;
-          boxes += d.size();
-          const auto l = toLabels(d, calib, frame);
-          out.insert(out.end(), l.begin(), l.end());
-        }
-      } else {
-        for (const auto& [frame, labels] : dets) {
-          const Detections d = st.run(toDetections(labels, calib));
-          boxes += d.size();
-          const auto l = toLabels(d, calib, frame);
-          out.insert(out.end(), l.begin(), l.end());
-        }
-      }
-      kitti::writeTrackingLabels(a.out + "/" + seq + ".txt", out);
+    return boxes;
+  }
+  kitti::TrackingDataset ds(a.data);
+  const std::vector<std::string> seqs = a.sequences.empty() ? ds.sequences() : eval::parseSequenceList(a.sequences);
+  std::size_t total_frames = 0;
+  for (const std::string& seq : seqs) total_frames += ds.frames(seq).size();
+  ProgressBar bar("detect", total_frames);
+  for (const std::string& seq : seqs) {
+    const kitti::Calibration calib = kitti::readCalibration(ds.calibPath(seq));
+    const auto poses = ds.lidarPoses(seq);
+    if (poses.empty()) {
+      if (p->tracks()) throw std::runtime_error("sequence " + seq + ": no ego poses (pose/ or oxts/) for tracking");
+      RET3D_WARN("sequence " << seq << ": no ego poses; the previous sweep is used unmoved");
+    }
+    auto pose = [&](int f) {
+      return f >= 0 && f < static_cast<int>(poses.size()) ? poses[static_cast<std::size_t>(f)]
+                                                          : Eigen::Isometry3d::Identity();
+    };
+    p->reset();
+    std::vector<kitti::Label> out;
+    PointCloud previous;
+    int previous_frame = -2;
+    for (const int frame : ds.frames(seq)) {
+      const PointCloud cloud = kitti::readVelodyne(ds.velodynePath(seq, frame));
+      const bool has_prev = previous_frame == frame - 1;
+      const Eigen::Isometry3d prev_to_current = pose(frame).inverse() * pose(frame - 1);
+      const Detections d = p->run(&cloud, has_prev ? &previous : nullptr, prev_to_current, {}, 0.1 * frame, pose(frame));
+      boxes += d.size();
+      const auto l = toLabels(d, calib, frame);
+      out.insert(out.end(), l.begin(), l.end());
+      previous = cloud;
+      previous_frame = frame;
       bar.tick();
     }
+    kitti::writeTrackingLabels(a.out + "/" + seq + ".txt", out);
   }
-  std::cout << "detect: " << st.frames << " frames, " << boxes << " boxes written to " << a.out;
-  if (st.intra && st.frames > 0)
-    std::cout << "; IntraRM " << 1000.0 * st.seconds / static_cast<double>(st.frames) << " ms per frame";
-  if (st.tracking && st.tracking->frames() > 0) {
-    const double n = static_cast<double>(st.tracking->frames());
-    std::cout << "; tracker " << 1000.0 * st.tracking->trackerSeconds() / n << " ms per frame";
-    if (st.inter) std::cout << ", InterRM " << 1000.0 * st.tracking->interSeconds() / n << " ms per frame";
+  return boxes;
+}
+
+// The later stages on another detector's result files.
+std::size_t detectFromResults(const DetectArgs& a, OfflinePipeline* p) {
+  const io::DetectionLayout layout = io::detectDetectionLayout(a.detections);
+  const Eigen::Isometry3d I = Eigen::Isometry3d::Identity();
+  std::size_t boxes = 0;
+  if (layout == io::DetectionLayout::KittiObject) {
+    if (p->tracks())
+      throw std::runtime_error("--stages track/inter need sequences: " + a.detections + " holds per-frame object results");
+    kitti::ObjectDataset ds(a.data);
+    const auto frames = ds.frames();
+    ProgressBar bar("detect", frames.size());
+    for (const std::string& fr : frames) {
+      const kitti::Calibration calib = kitti::readCalibration(ds.calibPath(fr));
+      const Detections d = p->run(nullptr, nullptr, I, toDetections(io::readFrameDetections(a.detections, fr), calib), 0, I);
+      boxes += d.size();
+      kitti::writeObjectLabels(a.out + "/" + fr + ".txt", toLabels(d, calib, -1));
+      bar.tick();
+    }
+    return boxes;
   }
-  std::cout << std::endl;
+  kitti::TrackingDataset ds(a.data);
+  const std::vector<std::string> seqs = a.sequences.empty() ? ds.sequences() : eval::parseSequenceList(a.sequences);
+  ProgressBar bar("detect", seqs.size());
+  for (const std::string& seq : seqs) {
+    const kitti::Calibration calib = kitti::readCalibration(ds.calibPath(seq));
+    std::vector<kitti::Label> out;
+    const auto dets = io::readSequenceDetections(a.detections, layout, seq);
+    if (p->tracks()) {
+      // Every frame in order (frames without detections too: tracks coast), at 10 Hz, with the real ego poses.
+      const auto poses = ds.lidarPoses(seq);
+      if (poses.empty()) throw std::runtime_error("sequence " + seq + ": no ego poses (pose/ or oxts/) for tracking");
+      if (!dets.empty() && dets.rbegin()->first >= static_cast<int>(poses.size()))
+        throw std::runtime_error("sequence " + seq + ": detections in frame " + std::to_string(dets.rbegin()->first) +
+                                 " beyond its " + std::to_string(poses.size()) + " poses");
+      p->reset();
+      for (int frame = 0; frame < static_cast<int>(poses.size()); ++frame) {
+        const auto it = dets.find(frame);
+        const Detections d = p->run(nullptr, nullptr, I, it == dets.end() ? Detections{} : toDetections(it->second, calib),
+                                    0.1 * frame, poses[static_cast<std::size_t>(frame)]);
+        boxes += d.size();
+        const auto l = toLabels(d, calib, frame);
+        out.insert(out.end(), l.begin(), l.end());
+      }
+    } else {
+      for (const auto& [frame, labels] : dets) {
+        const Detections d = p->run(nullptr, nullptr, I, toDetections(labels, calib), 0, I);
+        boxes += d.size();
+        const auto l = toLabels(d, calib, frame);
+        out.insert(out.end(), l.begin(), l.end());
+      }
+    }
+    kitti::writeTrackingLabels(a.out + "/" + seq + ".txt", out);
+    bar.tick();
+  }
+  return boxes;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+int runDetect(DetectArgs a) {
+  a.pipeline.stages = parseStages(a.stages);
+  const bool base = !a.pipeline.stages.empty() && a.pipeline.stages.front() == "base";
+  if (a.data.empty() || a.out.empty()) throw std::runtime_error("--data and --out are required");
+  if (base && !a.detections.empty())
+    throw std::runtime_error("--detections and the base stage exclude each other: the base stage makes the boxes");
+  if (!base && a.detections.empty())
+    throw std::runtime_error("without the base stage the boxes come from --detections DIR (another detector's results)");
+  OfflinePipeline p(a.pipeline);
+  std::cout << "detect: " << p.describe() << std::endl;
+  fs::create_directories(a.out);
+  const std::size_t boxes = base ? detectFromScans(a, &p) : detectFromResults(a, &p);
+  const auto& t = p.times().all();
+  const std::size_t frames = t.count("total") ? t.at("total").size() : 0;
+  std::cout << "detect: " << frames << " frames, " << boxes << " boxes written to " << a.out;
+  for (const char* stage : {"bev", "network", "decode", "nms", "intra", "track", "inter", "total"})
+    if (t.count(stage)) std::cout << "; " << stage << " " << median(t.at(stage)) << " ms";
+  std::cout << " (medians per frame; `ret3d bench` for timings)" << std::endl;
   return 0;
 }
 
-CommandRegistrar reg("detect", "run detection stages offline (IntraRM on another detector's boxes) to KITTI results",
+CommandRegistrar reg("detect", "run the pipeline offline (base detector, IntraRM, tracker, InterRM) to KITTI results",
                      [](CLI::App& app) -> CommandRun {
   auto a = std::make_shared<DetectArgs>();
-  app.add_option("--data", a->data, "KITTI tracking or object root (calibration)");
+  PipelineConfig& p = a->pipeline;
+  app.add_option("--data", a->data, "KITTI tracking or object root: scans for the base stage, calibration, poses")
+      ->required();
   app.add_option("--detections", a->detections,
-                 "input boxes: KITTI object/tracking result files or per-class CSV folders");
-  app.add_option("--stages", a->stages, "comma-separated stages to run: intra, track, inter, none")->capture_default_str();
-  app.add_option("--intra-model", a->intra_model, "IntraRM model file (for the intra stage)");
-  app.add_option("--inter-model", a->inter_model, "InterRM model file (for the inter stage)");
-  app.add_option("--tracker-config", a->tracker_config, "tracker YAML for track/inter (default: config/tracker.yaml's "
+                 "without the base stage: input boxes (KITTI object/tracking result files or per-class CSV folders)");
+  app.add_option("--stages", a->stages, "comma-separated stages in order: base, intra, track, inter; none")
+      ->capture_default_str();
+  app.add_option("--models", p.models, "folder with detector.pt, intra_rm.pt, inter_rm.pt (e.g. models/lwd3d)");
+  app.add_option("--detector-model", p.detector_model, "detector model file (overrides --models)");
+  app.add_option("--detector-config", p.detector_config,
+                 "detector YAML for inference options (default: the config stored in the model file)");
+  app.add_option("--score-threshold", p.score_threshold, "detector score threshold (default: the model's)");
+  app.add_option("--intra-model", p.intra_model, "IntraRM model file (overrides --models)");
+  app.add_option("--inter-model", p.inter_model, "InterRM model file (overrides --models)");
+  app.add_option("--tracker-config", p.tracker_config, "tracker YAML for track/inter (default: config/tracker.yaml's "
                  "values, built in)");
   app.add_option("--sequences", a->sequences, "tracking sequences, e.g. 16-20 (default: all)");
-  app.add_option("--out", a->out, "output folder for KITTI result files");
-  app.add_option("--threads", a->threads, "CPU threads for libtorch")->capture_default_str();
+  app.add_option("--out", a->out, "output folder for KITTI result files")->required();
+  app.add_option("--threads", p.threads, "CPU threads for libtorch")->capture_default_str();
   return [a]() { return runDetect(*a); };
 });
 

@@ -13,7 +13,7 @@ namespace {
 CommandRun setup(CLI::App& app) {
   auto job = std::make_shared<DetectorTrainJob>();
   auto config = std::make_shared<std::string>();
-  app.add_option("--data", job->data_dir, "KITTI tracking-layout folder (ROOT or ROOT/training)")
+  app.add_option("--data", job->data_dirs, "KITTI tracking-layout folder(s) (ROOT or ROOT/training), used together")
       ->required()
       ->check(CLI::ExistingDirectory);
   app.add_option("--config", *config, "detector config YAML (config/detector/*.yaml)")
@@ -21,12 +21,16 @@ CommandRun setup(CLI::App& app) {
       ->check(CLI::ExistingFile);
   app.add_option("--out", job->out_model, "model file to write; checkpoints go beside it (<out>.ckpt*)")->required();
   app.add_flag("--resume", job->resume, "continue from <out>.ckpt when present");
-  return [job, config]() -> int {
+  auto threads = std::make_shared<int>(0);
+  app.add_option("--threads", *threads, "torch threads (default: the config's train.threads, else inference.threads)")
+      ->check(CLI::PositiveNumber);
+  return [job, config, threads]() -> int {
     std::ifstream in(*config);
     std::stringstream ss;
     ss << in.rdbuf();
     job->config_text = ss.str();
     job->options = detectorOptionsFromYaml(job->config_text, *config);
+    if (*threads > 0) job->options.train.threads = *threads;
     const DetectorTrainResult r = trainDetector(*job);
     std::cout << "trained " << r.steps << " steps in " << r.seconds << " s, last epoch loss " << r.last_loss
               << ", model " << job->out_model << std::endl;

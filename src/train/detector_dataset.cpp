@@ -28,8 +28,23 @@ bool isIgnoredType(const ModelConfig& m, const std::string& type) {
 
 }  // namespace
 
-DetectorDataset::DetectorDataset(const std::string& root, const ModelConfig& model, int max_frames)
-    : root_(root), model_(model) {
+DetectorDataset::DetectorDataset(const std::vector<std::string>& roots, const ModelConfig& model, int max_frames)
+    : model_(model) {
+  for (const std::string& root : roots) addRoot(root);
+  if (frames_.empty()) {
+    std::string all;
+    for (const std::string& r : roots) all += (all.empty() ? "" : ", ") + r;
+    throw std::runtime_error(all + ": no labelled frames with scans (KITTI tracking layout expected)");
+  }
+  if (max_frames > 0 && static_cast<int>(frames_.size()) > max_frames) {
+    // Spread the subset over the whole set rather than taking its beginning.
+    std::vector<Frame> subset;
+    for (int i = 0; i < max_frames; ++i) subset.push_back(frames_[i * frames_.size() / max_frames]);
+    frames_ = subset;
+  }
+}
+
+void DetectorDataset::addRoot(const std::string& root) {
   kitti::TrackingDataset ds(root);
   for (const std::string& name : ds.sequences()) {
     const std::vector<int> frames = ds.frames(name);
@@ -39,6 +54,7 @@ DetectorDataset::DetectorDataset(const std::string& root, const ModelConfig& mod
       continue;
     }
     Sequence s;
+    s.root = root;
     s.name = name;
     s.poses = ds.lidarPoses(name);
     if (s.poses.empty()) RET3D_WARN("sequence " << name << ": no poses; the ego motion is taken as zero");
@@ -57,13 +73,6 @@ DetectorDataset::DetectorDataset(const std::string& root, const ModelConfig& mod
       const int prev = i > 0 && frames[i - 1] == frames[i] - 1 ? frames[i - 1] : -1;
       frames_.push_back({seqs_.size() - 1, frames[i], prev});
     }
-  }
-  if (frames_.empty()) throw std::runtime_error(root + ": no labelled frames with scans (KITTI tracking layout expected)");
-  if (max_frames > 0 && static_cast<int>(frames_.size()) > max_frames) {
-    // Spread the subset over the whole set rather than taking its beginning.
-    std::vector<Frame> subset;
-    for (int i = 0; i < max_frames; ++i) subset.push_back(frames_[i * frames_.size() / max_frames]);
-    frames_ = subset;
   }
 }
 
@@ -85,7 +94,7 @@ std::vector<Box> DetectorDataset::allBoxes() const {
 DetectorSample DetectorDataset::load(std::size_t i) const {
   const Frame& f = frames_.at(i);
   const Sequence& s = seqs_[f.seq];
-  kitti::TrackingDataset ds(root_);
+  kitti::TrackingDataset ds(s.root);
   DetectorSample out;
   char id[64];
   std::snprintf(id, sizeof(id), "%s/%06d", s.name.c_str(), f.frame);
@@ -209,8 +218,16 @@ BevGeometry multiscaleGeometry(const BevGeometry& g, const TrainOptions& t, std:
   const int side = 32 * (t.multiscale_base + n);  // LWD-3D eq. (4)
   if (side <= 0) return g;
   BevGeometry out = g;
-  const double cx = 0.5 * (g.x_min + g.x_max), cy = 0.5 * (g.y_min + g.y_max);
+  double cx = 0.5 * (g.x_min + g.x_max), cy = 0.5 * (g.y_min + g.y_max);
   const double half = 0.5 * side * g.resolution;
+  if (t.multiscale_random_position) {
+    // Whole cells only, so the crop's cells coincide with the full grid's.
+    std::uniform_real_distribution<double> U(0.0, 1.0);
+    const int free_x = std::max(0, static_cast<int>(std::lround((g.x_max - g.x_min) / g.resolution)) - side);
+    const int free_y = std::max(0, static_cast<int>(std::lround((g.y_max - g.y_min) / g.resolution)) - side);
+    cx = g.x_min + half + g.resolution * std::floor(U(*rng) * (free_x + 1));
+    cy = g.y_min + half + g.resolution * std::floor(U(*rng) * (free_y + 1));
+  }
   out.x_min = cx - half, out.x_max = cx + half;
   out.y_min = cy - half, out.y_max = cy + half;
   return out;

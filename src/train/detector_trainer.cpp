@@ -56,11 +56,13 @@ DetectorTrainResult trainDetector(const DetectorTrainJob& job) {
   const DetectorOptions& o = job.options;
   const TrainOptions& t = o.train;
   o.model.validate();
-  torch::set_num_threads(o.inference.threads);
+  torch::set_num_threads(t.threads > 0 ? t.threads : o.inference.threads);
   torch::manual_seed(t.seed);
 
-  DetectorDataset data(job.data_dir, o.model, t.max_frames);
-  RET3D_INFO("train detector: " << data.size() << " frames from " << job.data_dir << ", head "
+  DetectorDataset data(job.data_dirs, o.model, t.max_frames);
+  std::string dirs;
+  for (const std::string& d : job.data_dirs) dirs += (dirs.empty() ? "" : ", ") + d;
+  RET3D_INFO("train detector: " << data.size() << " frames from " << dirs << ", head "
                                 << headTypeName(o.model.head) << ", grid " << o.model.geometry.describe());
 
   std::shared_ptr<nn::DetectorModel> model;

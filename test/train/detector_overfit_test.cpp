@@ -178,7 +178,7 @@ TEST_P(DetectorOverfitTest, ReachesNearPerfectAPOnItsTrainingFrames) {
   test::TempDir dir;
   const Scene scene = writeDataset(dir.path());
   DetectorTrainJob job;
-  job.data_dir = dir.path();
+  job.data_dirs = {dir.path()};
   job.out_model = dir / "tiny.ret3d";
   job.options = tinyOptions(GetParam());
   // The centre head's sparse positives (one cell per object) need longer than the anchor head's three per anchor.

@@ -93,6 +93,10 @@ struct TrainOptions {
   // objects keep their size in cells); n_max < n_min = off (the configured grid).
   int multiscale_base = 12;
   int multiscale_n_min = 0, multiscale_n_max = -1;
+  // Place each batch's smaller grid at a random spot inside the configured one (a random crop of the BEV, so that a
+  // cheaper grid still trains on far objects) instead of at its centre.
+  bool multiscale_random_position = false;
+  int threads = 0;                // torch threads while training (0 = inference.threads)
   // Real KITTI labels cover only the front camera's view: supervise objectness only within +-fov/2 of x (0 = all).
   double supervised_fov_deg = 0.0;
   double loss_weight_regression = 2.0;

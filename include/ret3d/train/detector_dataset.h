@@ -26,8 +26,11 @@ struct DetectorSample {
 
 class DetectorDataset {
  public:
-  // Indexes every frame with a scan (labels are read now; scans on load()). Throws when the folder has no sequences.
-  DetectorDataset(const std::string& root, const ModelConfig& model, int max_frames = 0);
+  // Indexes every frame with a scan (labels are read now; scans on load()) of one or more folders, e.g. urban and
+  // highway simulations. Throws when they have no labelled sequences.
+  DetectorDataset(const std::vector<std::string>& roots, const ModelConfig& model, int max_frames = 0);
+  DetectorDataset(const std::string& root, const ModelConfig& model, int max_frames = 0)
+      : DetectorDataset(std::vector<std::string>{root}, model, max_frames) {}
   std::size_t size() const { return frames_.size(); }
   DetectorSample load(std::size_t i) const;
   // Every labelled box of the model's classes (for the k-means anchors).
@@ -40,13 +43,14 @@ class DetectorDataset {
     int previous;     // -1 when none
   };
   struct Sequence {
+    std::string root;                            // the dataset folder it belongs to
     std::string name;
     std::vector<Eigen::Isometry3d> poses;       // T_velo0_velo_t, empty when absent
     std::vector<std::vector<Box>> boxes;         // per frame index: every labelled box (class Unknown for others)
     std::vector<std::vector<std::string>> types; // the KITTI type of each box
   };
+  void addRoot(const std::string& root);
   Eigen::Isometry3d motion(const Sequence& s, int from, int to) const;  // T_to_from
-  std::string root_;
   ModelConfig model_;
   std::vector<Sequence> seqs_;
   std::vector<Frame> frames_;

@@ -5,13 +5,14 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "ret3d/detector/detector_options.h"
 
 namespace ret3d {
 
 struct DetectorTrainJob {
-  std::string data_dir;       // KITTI tracking layout
+  std::vector<std::string> data_dirs;  // KITTI tracking layout folders, used together
   std::string out_model;      // final model file; checkpoints beside it (<out>.ckpt, <out>.ckpt.optim)
   DetectorOptions options;
   std::string config_text;    // the YAML the options came from, stored in the model file

@@ -1,0 +1,215 @@
+// `ret3d bench --data DIR|--bag FILE --models DIR [--stages LIST] [--json FILE]`: times each stage of the pipeline
+// over real frames, after a warm-up, and prints the median and p95 per stage (the base detector split into BEV,
+// network, decoding and NMS). Scans come from a KITTI tracking or object folder, a folder of .bin scans, or the
+// PointCloud2 messages of a bag. Frames are cycled until --min-runs timed runs, so a short drive still gives a p95.
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <thread>
+
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <sensor_msgs/PointCloud2.h>
+
+#include "ret3d/core/log.h"
+#include "ret3d/io/kitti.h"
+#include "ret3d/ros/conversions.h"
+#include "tools/command.h"
+#include "tools/offline_pipeline.h"
+
+namespace ret3d {
+namespace tools {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct BenchArgs {
+  PipelineConfig pipeline;
+  std::string data, bag, topic, stages = "base,intra,track,inter", json, sequence;
+  int warmup = 5, min_runs = 100, max_frames = 200;
+};
+
+// One input frame: the scan and the ego motion from the previous one (identity when unknown).
+struct BenchFrame {
+  PointCloud cloud;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // sensor -> fixed
+  bool follows = false;                                    // the previous entry is the previous sweep
+};
+
+std::vector<BenchFrame> framesFromData(const BenchArgs& a) {
+  std::vector<BenchFrame> out;
+  auto binsIn = [](const fs::path& dir) {
+    std::vector<std::string> bins;
+    if (fs::is_directory(dir))
+      for (const auto& e : fs::directory_iterator(dir))
+        if (e.is_regular_file() && e.path().extension() == ".bin") bins.push_back(e.path().string());
+    std::sort(bins.begin(), bins.end());
+    return bins;
+  };
+  // A folder of scans (e.g. ../shared/data/unlabeled_scans), or the object layout: consecutive files are not
+  // necessarily consecutive sweeps, but the 22 unlabeled scans are; the motion between them is unknown (identity).
+  for (const fs::path dir : {fs::path(a.data), fs::path(a.data) / "velodyne", fs::path(a.data) / "training" / "velodyne"}) {
+    const auto bins = binsIn(dir);
+    if (bins.empty()) continue;
+    for (const std::string& b : bins) {
+      if (static_cast<int>(out.size()) >= a.max_frames) break;
+      out.push_back({kitti::readVelodyne(b), Eigen::Isometry3d::Identity(), !out.empty()});
+    }
+    return out;
+  }
+  kitti::TrackingDataset ds(a.data);
+  const auto seqs = ds.sequences();
+  if (seqs.empty()) throw std::runtime_error(a.data + ": no scans (a folder of .bin files or a KITTI layout expected)");
+  const std::string seq = a.sequence.empty() ? seqs.front() : a.sequence;
+  const auto poses = ds.lidarPoses(seq);
+  int prev = -2;
+  for (const int f : ds.frames(seq)) {
+    if (static_cast<int>(out.size()) >= a.max_frames) break;
+    BenchFrame fr;
+    fr.cloud = kitti::readVelodyne(ds.velodynePath(seq, f));
+    if (f < static_cast<int>(poses.size())) fr.pose = poses[static_cast<std::size_t>(f)];
+    fr.follows = prev == f - 1;
+    prev = f;
+    out.push_back(std::move(fr));
+  }
+  return out;
+}
+
+std::vector<BenchFrame> framesFromBag(const BenchArgs& a) {
+  rosbag::Bag bag(a.bag, rosbag::bagmode::Read);
+  std::string topic = a.topic;
+  if (topic.empty()) {
+    rosbag::View all(bag);
+    for (const rosbag::ConnectionInfo* c : all.getConnections())
+      if (c->datatype == "sensor_msgs/PointCloud2") {
+        topic = c->topic;
+        break;
+      }
+    if (topic.empty()) throw std::runtime_error(a.bag + ": no sensor_msgs/PointCloud2 topic");
+  }
+  std::vector<BenchFrame> out;
+  rosbag::View view(bag, rosbag::TopicQuery(topic));
+  for (const rosbag::MessageInstance& m : view) {
+    if (static_cast<int>(out.size()) >= a.max_frames) break;
+    const auto msg = m.instantiate<sensor_msgs::PointCloud2>();
+    if (!msg) continue;
+    out.push_back({ret3d::toCloud(*msg), Eigen::Isometry3d::Identity(), !out.empty()});
+  }
+  if (out.empty()) throw std::runtime_error(a.bag + ": no PointCloud2 messages on " + topic);
+  std::cout << "bench: " << out.size() << " clouds from " << a.bag << " " << topic
+            << " (ego motion taken as zero: the timing does not depend on it)\n";
+  return out;
+}
+
+struct Summary {
+  double median = 0, p95 = 0;
+};
+
+Summary summarise(std::vector<double> v) {
+  Summary s;
+  if (v.empty()) return s;
+  std::sort(v.begin(), v.end());
+  s.median = v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+  s.p95 = v[std::min(v.size() - 1, static_cast<std::size_t>(std::ceil(0.95 * v.size())) - 1)];
+  return s;
+}
+
+int runBench(BenchArgs a) {
+  if (a.data.empty() == a.bag.empty()) throw std::runtime_error("give exactly one of --data DIR and --bag FILE");
+  a.pipeline.stages = parseStages(a.stages);
+  if (a.pipeline.stages.empty() || a.pipeline.stages.front() != "base")
+    throw std::runtime_error("--stages must start with base: the bench runs on point clouds (bench-intra times "
+                             "IntraRM alone on synthetic layouts)");
+  const std::vector<BenchFrame> frames = a.bag.empty() ? framesFromData(a) : framesFromBag(a);
+  if (frames.empty()) throw std::runtime_error("no frames to time");
+  OfflinePipeline p(a.pipeline);
+  std::size_t points = 0;
+  for (const BenchFrame& f : frames) points += f.cloud.size();
+  std::cout << "bench: " << p.describe() << "\n"
+            << "bench: " << frames.size() << " frames, " << points / frames.size() << " points per scan on average, "
+            << a.pipeline.threads << " threads, " << a.warmup << " warm-up runs, at least " << a.min_runs
+            << " timed runs; " << std::thread::hardware_concurrency() << " cores here\n";
+  int runs = 0, pass = 0;
+  std::size_t boxes = 0;
+  while (runs < a.min_runs + a.warmup) {
+    p.reset();
+    for (std::size_t i = 0; i < frames.size() && runs < a.min_runs + a.warmup; ++i, ++runs) {
+      if (runs == a.warmup) p.clearTimes();
+      const BenchFrame& f = frames[i];
+      const bool prev = i > 0 && f.follows;
+      const Eigen::Isometry3d prev_to_current =
+          prev ? Eigen::Isometry3d(f.pose.inverse() * frames[i - 1].pose) : Eigen::Isometry3d::Identity();
+      // Each pass is a new stretch of time for the tracker.
+      const double stamp = 0.1 * static_cast<double>(i) + 1000.0 * pass;
+      const Detections d = p.run(&f.cloud, prev ? &frames[i - 1].cloud : nullptr, prev_to_current, {}, stamp, f.pose);
+      if (runs >= a.warmup) boxes += d.size();
+    }
+    ++pass;
+  }
+  const auto& t = p.times().all();
+  std::cout << std::left << std::setw(10) << "stage" << std::right << std::setw(12) << "median ms" << std::setw(12)
+            << "p95 ms" << "\n";
+  std::ostringstream json;
+  json << "{";
+  bool first = true;
+  for (const char* stage : {"bev", "network", "decode", "nms", "intra", "track", "inter", "total"}) {
+    if (!t.count(stage)) continue;
+    const Summary s = summarise(t.at(stage));
+    std::cout << std::left << std::setw(10) << stage << std::right << std::fixed << std::setprecision(3)
+              << std::setw(12) << s.median << std::setw(12) << s.p95 << "\n";
+    json << (first ? "" : ", ") << "\"" << stage << "\": {\"median_ms\": " << s.median << ", \"p95_ms\": " << s.p95
+         << "}";
+    first = false;
+  }
+  // The base detector alone (BEV + network + decoding + NMS), the figure of the latency budget.
+  std::vector<double> base;
+  for (std::size_t i = 0; i < t.at("bev").size(); ++i)
+    base.push_back(t.at("bev")[i] + t.at("network")[i] + t.at("decode")[i] + t.at("nms")[i]);
+  const Summary sb = summarise(base);
+  std::cout << std::left << std::setw(10) << "base" << std::right << std::setw(12) << sb.median << std::setw(12) << sb.p95
+            << "   (bev + network + decode + nms)\n";
+  json << ", \"base\": {\"median_ms\": " << sb.median << ", \"p95_ms\": " << sb.p95 << "}";
+  const Detector* det = p.detector();
+  const std::string model = det->options().inference.model_path;
+  std::cout << "detector: " << det->parameterCount() << " parameters, model file " << fs::file_size(model)
+            << " bytes; " << static_cast<double>(boxes) / std::max(1, a.min_runs) << " boxes per frame\n";
+  json << ", \"parameters\": " << det->parameterCount() << ", \"model_bytes\": " << fs::file_size(model)
+       << ", \"frames\": " << frames.size() << ", \"runs\": " << a.min_runs << ", \"threads\": " << a.pipeline.threads
+       << "}\n";
+  if (!a.json.empty()) {
+    if (fs::path(a.json).has_parent_path()) fs::create_directories(fs::path(a.json).parent_path());
+    std::ofstream(a.json) << json.str();
+    std::cout << "bench: wrote " << a.json << "\n";
+  }
+  return 0;
+}
+
+CommandRegistrar reg("bench", "time each pipeline stage over real scans (median and p95)", [](CLI::App& app) -> CommandRun {
+  auto a = std::make_shared<BenchArgs>();
+  PipelineConfig& p = a->pipeline;
+  app.add_option("--data", a->data, "scans: a folder of .bin files, a KITTI object or tracking folder");
+  app.add_option("--sequence", a->sequence, "tracking layout: the sequence to time (default: the first)");
+  app.add_option("--bag", a->bag, "scans: the PointCloud2 messages of a bag");
+  app.add_option("--topic", a->topic, "bag topic (default: the first PointCloud2 topic)");
+  app.add_option("--models", p.models, "folder with detector.pt, intra_rm.pt, inter_rm.pt (e.g. models/lwd3d)");
+  app.add_option("--detector-model", p.detector_model, "detector model file (overrides --models)");
+  app.add_option("--intra-model", p.intra_model, "IntraRM model file (overrides --models)");
+  app.add_option("--inter-model", p.inter_model, "InterRM model file (overrides --models)");
+  app.add_option("--tracker-config", p.tracker_config, "tracker YAML (default: built-in values)");
+  app.add_option("--score-threshold", p.score_threshold, "detector score threshold (default: the model's)");
+  app.add_option("--stages", a->stages, "comma-separated stages in order, starting with base")->capture_default_str();
+  app.add_option("--threads", p.threads, "CPU threads for libtorch")->capture_default_str();
+  app.add_option("--warmup", a->warmup, "untimed runs first")->capture_default_str();
+  app.add_option("--min-runs", a->min_runs, "timed runs (frames are cycled)")->capture_default_str();
+  app.add_option("--max-frames", a->max_frames, "frames read at most")->capture_default_str();
+  app.add_option("--json", a->json, "write {\"<stage>\": {\"median_ms\", \"p95_ms\"}, ..., \"total\": {...}}");
+  return [a]() { return runBench(*a); };
+});
+
+}  // namespace
+}  // namespace tools
+}  // namespace ret3d
