@@ -164,4 +164,18 @@ std::vector<std::string> checkModelMetadata(const ModelMetadata& file, const Mod
   return diffs;
 }
 
+DetectorOptions detectorOptionsForModel(const std::string& model_path, const std::string& config_yaml) {
+  DetectorOptions o;
+  if (!config_yaml.empty()) {
+    o = loadDetectorOptions(config_yaml);
+  } else {
+    const ModelFileContents file = readModelFile(model_path);
+    if (file.metadata.trained_with.empty())
+      throw ModelFileError(model_path + ": the file does not store the config it was trained with; give a detector config YAML");
+    o = detectorOptionsFromYaml(file.metadata.trained_with, model_path + " (trained_with)");
+  }
+  o.inference.model_path = model_path;
+  return o;
+}
+
 }  // namespace ret3d

@@ -51,20 +51,6 @@ std::vector<std::string> parseStages(const std::string& list) {
   return out;
 }
 
-DetectorOptions detectorOptionsForModel(const std::string& model_path, const std::string& config_yaml) {
-  DetectorOptions o;
-  if (!config_yaml.empty()) {
-    o = loadDetectorOptions(config_yaml);
-  } else {
-    const ModelFileContents file = readModelFile(model_path);
-    if (file.metadata.trained_with.empty())
-      throw std::runtime_error(model_path + ": the file does not store its training config; pass --detector-config");
-    o = detectorOptionsFromYaml(file.metadata.trained_with, model_path + " (trained_with)");
-  }
-  o.inference.model_path = model_path;
-  return o;
-}
-
 OfflinePipeline::OfflinePipeline(const PipelineConfig& c) : stages_(c.stages) {
   std::ostringstream desc;
   desc << "stages";

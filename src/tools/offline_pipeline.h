@@ -75,9 +75,5 @@ class OfflinePipeline {
   StageTimes times_;
 };
 
-// The detector's options for a model file: the config it was trained with (stored in the file), or `config_yaml`
-// when given, with the file as model_path.
-DetectorOptions detectorOptionsForModel(const std::string& model_path, const std::string& config_yaml);
-
 }  // namespace tools
 }  // namespace ret3d

@@ -49,4 +49,9 @@ ModelFileContents readModelFile(const std::string& path);
 // Differences between a file's model and the configured one, one line each; empty when they match.
 std::vector<std::string> checkModelMetadata(const ModelMetadata& file, const ModelConfig& expected);
 
+// The detector's options for a model file: the config it was trained with (stored in the file), or the YAML file
+// `config_yaml` when not empty (its model part must then match the file's), with the file as model_path. Throws
+// ModelFileError / std::runtime_error saying what is wrong.
+DetectorOptions detectorOptionsForModel(const std::string& model_path, const std::string& config_yaml = "");
+
 }  // namespace ret3d

@@ -1,0 +1,274 @@
+// `ret3d draw`: a bird's-eye-view PNG of one scan with boxes over it: the points in grey, KITTI ground truth in white
+// (when --labels and --calib are given), and detections coloured by class as in rviz (classColour of
+// src/ros/markers.h: Car green, Pedestrian magenta, Cyclist orange), each with a line from its centre to its front.
+// The detections come from the LWD-3D detector run in-process (--models DIR or --detector-model FILE; no calibration
+// needed, boxes stay in the LiDAR frame), or from a KITTI result file (--pred FILE, camera coordinates, needs --calib).
+//   ret3d draw --scan ../shared/data/unlabeled_scans/000010.bin --models models/lwd3d --out docs/scan.png
+//   ret3d draw --scan velodyne/000134.bin --labels label_2/000134.txt --calib calib/000134.txt \
+//              --models models/lwd3d --view front --out real_000134.png
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <optional>
+#include <sstream>
+
+#include "ret3d/core/detections.h"
+#include "ret3d/core/geometry.h"
+#include "ret3d/core/log.h"
+#include "ret3d/io/kitti.h"
+#include "ret3d/ros/markers.h"
+#include "tools/bev_image.h"
+#include "tools/command.h"
+#include "tools/offline_pipeline.h"
+
+namespace ret3d {
+namespace tools {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct DrawArgs {
+  PipelineConfig pipeline;
+  std::string scan, labels, calib, pred, out, title;
+  std::string view = "around", extent, shade = "height";
+  int size = 1000;
+  bool no_scores = false;
+};
+
+const Rgb kWhite{255, 255, 255};
+const Rgb kOtherGt{150, 150, 150};   // labelled objects the benchmark ignores (Van, Truck, Person_sitting, ...)
+const Rgb kRings{45, 45, 75};
+const Rgb kFov{110, 110, 40};
+const Rgb kEgo{80, 160, 255};
+const Rgb kText{230, 230, 230};
+
+std::vector<double> parseExtent(const std::string& s) {
+  std::vector<double> v;
+  std::stringstream ss(s);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    try {
+      std::size_t used = 0;
+      v.push_back(std::stod(item, &used));
+      if (used != item.size()) throw std::invalid_argument(item);
+    } catch (const std::exception&) {
+      throw std::invalid_argument("--extent: '" + item + "' is not a number (expected x_min,x_max,y_min,y_max)");
+    }
+  }
+  if (v.size() != 4) throw std::invalid_argument("--extent: expected 4 numbers x_min,x_max,y_min,y_max, got '" + s + "'");
+  return v;
+}
+
+std::string fixed(double v, int decimals) {
+  std::ostringstream o;
+  o << std::fixed << std::setprecision(decimals) << v;
+  return o.str();
+}
+
+// The bearings (radians, in the LiDAR frame) between which ground points project into camera 2's image (KITTI's
+// 1242 pixels wide): the part of the scan the labels cover.
+bool cameraFov(const kitti::Calibration& calib, double* left, double* right) {
+  bool any = false;
+  for (int i = -900; i <= 900; ++i) {
+    const double a = i * M_PI / 1800.0;
+    const Eigen::Vector3d p(30.0 * std::cos(a), 30.0 * std::sin(a), -1.0);
+    const auto uv = calib.projectRect(calib.veloToRect(p));
+    if (!uv || uv->x() < 0 || uv->x() > 1242) continue;
+    if (!any) *right = *left = a;
+    *right = std::min(*right, a);
+    *left = std::max(*left, a);
+    any = true;
+  }
+  return any;
+}
+
+// Boxes of a KITTI label/result file in the LiDAR frame; `other` receives the non-DontCare labels of other types.
+std::vector<Box> readBoxes(const std::string& path, const kitti::Calibration& calib, std::vector<Box>* other) {
+  std::vector<Box> boxes;
+  for (const kitti::Label& l : kitti::readObjectLabels(path)) {
+    if (classFromName(l.type)) boxes.push_back(kitti::labelToBox(l, calib));
+    else if (other && l.type != "DontCare") other->push_back(kitti::labelToBox(l, calib));
+  }
+  return boxes;
+}
+
+// A block of text lines on a black background at (col, row); returns the height used.
+int textBlock(BevImage& img, int col, int row, const std::vector<std::pair<std::string, Rgb>>& lines, int scale) {
+  int w = 0;
+  for (const auto& l : lines) w = std::max(w, BevImage::textWidth(l.first, scale));
+  const int line_h = BevImage::textHeight(scale) + 3 * scale;
+  const int h = static_cast<int>(lines.size()) * line_h + 2 * scale;
+  img.fillRect(col, row, w + 6 * scale, h, {0, 0, 0});
+  for (std::size_t i = 0; i < lines.size(); ++i)
+    img.drawText(col + 3 * scale, row + 3 * scale + static_cast<int>(i) * line_h, lines[i].first, lines[i].second, scale);
+  return h;
+}
+
+int runDraw(DrawArgs a) {
+  if (a.scan.empty() || a.out.empty()) throw std::invalid_argument("--scan and --out are required");
+  const bool detector = !a.pipeline.models.empty() || !a.pipeline.detector_model.empty();
+  if (detector && !a.pred.empty())
+    throw std::invalid_argument("--pred and a detector (--models/--detector-model) exclude each other: draw one set");
+  if ((!a.labels.empty() || !a.pred.empty()) && a.calib.empty())
+    throw std::invalid_argument("--labels and --pred are KITTI camera coordinates: they need --calib FILE");
+  if (a.shade != "height" && a.shade != "intensity")
+    throw std::invalid_argument("--shade: 'height' or 'intensity', not '" + a.shade + "'");
+  if (a.view != "around" && a.view != "front")
+    throw std::invalid_argument("--view: 'around' or 'front', not '" + a.view + "'");
+  if (a.size < 100 || a.size > 8000) throw std::invalid_argument("--size: 100 to 8000 pixels");
+
+  const PointCloud cloud = kitti::readVelodyne(a.scan);
+  std::optional<kitti::Calibration> calib;
+  if (!a.calib.empty()) calib = kitti::readCalibration(a.calib);
+
+  // The detections: the detector in-process (the same code path as `ret3d detect --stages base`, one sweep), or a
+  // result file.
+  std::vector<Box> dets;
+  std::string source;
+  BevView view;
+  if (detector) {
+    a.pipeline.stages = {"base"};
+    OfflinePipeline p(a.pipeline);
+    const Detections d = p.run(&cloud, nullptr, Eigen::Isometry3d::Identity(), {}, 0.0, Eigen::Isometry3d::Identity());
+    dets = d.boxes;
+    const BevGeometry& g = p.detector()->options().model.geometry;
+    view.x_min = g.x_min;
+    view.x_max = g.x_max;
+    view.y_min = g.y_min;
+    view.y_max = g.y_max;
+    const std::string model = a.pipeline.detector_model.empty() ? a.pipeline.models + "/detector.pt"
+                                                                : a.pipeline.detector_model;
+    source = "LWD-3D " + fs::path(model).lexically_normal().string() + ", score >= " +
+             fixed(p.detector()->options().inference.score_threshold, 2);
+  } else if (!a.pred.empty()) {
+    dets = readBoxes(a.pred, *calib, nullptr);
+    if (a.pipeline.score_threshold >= 0)
+      dets.erase(std::remove_if(dets.begin(), dets.end(),
+                                [&](const Box& b) { return b.score < a.pipeline.score_threshold; }),
+                 dets.end());
+    source = fs::path(a.pred).filename().string();
+    if (a.pipeline.score_threshold >= 0) source += ", score >= " + fixed(a.pipeline.score_threshold, 2);
+  }
+  std::vector<Box> gt, gt_other;
+  if (!a.labels.empty()) gt = readBoxes(a.labels, *calib, &gt_other);
+
+  if (a.view == "front") {
+    // KITTI's evaluated area in front of the car (camera 2 looks forward): 0-70 m ahead, 40 m to each side.
+    view.x_min = 0.0;
+    view.x_max = 70.0;
+    view.y_min = -40.0;
+    view.y_max = 40.0;
+  }
+  if (!a.extent.empty()) {
+    const auto e = parseExtent(a.extent);
+    view.x_min = e[0];
+    view.x_max = e[1];
+    view.y_min = e[2];
+    view.y_max = e[3];
+  }
+  view.pixels_per_metre = a.size / std::max(view.x_max - view.x_min, view.y_max - view.y_min);
+  BevImage img(view);
+
+  // Background: range rings every 10 m, the camera's field of view, then the points.
+  for (int r = 10; r <= 150; r += 10) img.drawGroundCircle(0, 0, r, kRings);
+  if (calib) {
+    double left = 0, right = 0;
+    if (cameraFov(*calib, &left, &right)) {
+      for (const double ang : {left, right})
+        img.drawGroundLine({0, 0}, {150 * std::cos(ang), 150 * std::sin(ang)}, kFov);
+    }
+  }
+  img.drawPoints(cloud, a.shade == "height" ? PointShade::Height : PointShade::Intensity);
+
+  // Ego vehicle (a car-sized box at the sensor, facing forward), ground truth, then detections on top.
+  Box ego;
+  ego.length = 4.0;
+  ego.width = 1.8;
+  img.drawBox(ego, kEgo, 1, true);
+  const int thick = std::max(1, static_cast<int>(std::lround(view.pixels_per_metre / 5.0)));
+  for (const Box& b : gt_other) img.drawBox(b, kOtherGt, thick, false);
+  for (const Box& b : gt) img.drawBox(b, kWhite, thick + 2, false);
+  std::map<ObjectClass, int> counts;
+  for (const Box& b : dets) {
+    const Rgb c = toRgb(classColour(b.label));
+    img.drawBox(b, c, thick, true);
+    ++counts[b.label];
+    if (!a.no_scores) {
+      // The score just right of the box's outline.
+      double col = -1e9, row = 1e9;
+      for (const auto& corner : bevCorners(b)) {
+        const Eigen::Vector2d px = img.toPixel(corner.x(), corner.y());
+        col = std::max(col, px.x());
+        row = std::min(row, px.y());
+      }
+      img.drawText(static_cast<int>(col) + 3, static_cast<int>(row), fixed(b.score, 2), c, 1);
+    }
+  }
+
+  // Title, sources and legend top left; scale bar bottom right.
+  const int scale = img.width() >= 900 ? 2 : 1;
+  std::vector<std::pair<std::string, Rgb>> lines;
+  lines.push_back({a.title.empty() ? fs::path(a.scan).filename().string() : a.title, kText});
+  lines.push_back({std::to_string(cloud.size()) + " points, grey by " + a.shade, kText});
+  if (!source.empty()) {
+    std::string s = std::to_string(dets.size()) + " detections (" + source + ")";
+    lines.push_back({s, kText});
+    for (const ObjectClass c : kDetectedClasses)
+      lines.push_back({std::string(className(c)) + ": " + std::to_string(counts[c]), toRgb(classColour(c))});
+  }
+  if (!a.labels.empty()) {
+    lines.push_back({"ground truth: " + std::to_string(gt.size()), kWhite});
+    if (!gt_other.empty()) lines.push_back({"other labels (ignored): " + std::to_string(gt_other.size()), kOtherGt});
+    if (calib) lines.push_back({"camera view (labelled area)", kFov});
+  }
+  textBlock(img, 0, 0, lines, scale);
+  const double bar_m = 10.0;
+  const int bar_px = static_cast<int>(std::lround(bar_m * view.pixels_per_metre));
+  const int bx = img.width() - bar_px - 10 * scale, by = img.height() - 10 * scale;
+  img.fillRect(bx - 4 * scale, by - BevImage::textHeight(scale) - 8 * scale, bar_px + 8 * scale,
+               BevImage::textHeight(scale) + 14 * scale, {0, 0, 0});
+  img.fillRect(bx, by, bar_px, scale * 2, kText);
+  img.drawText(bx, by - BevImage::textHeight(scale) - 4 * scale, "10 m, rings every 10 m", kText, 1);
+
+  if (fs::path(a.out).has_parent_path()) fs::create_directories(fs::path(a.out).parent_path());
+  img.writePng(a.out);
+  std::cout << "draw: " << a.out << " (" << img.width() << " x " << img.height() << "), " << cloud.size()
+            << " points, " << dets.size() << " detections";
+  if (!a.labels.empty()) std::cout << ", " << gt.size() << " ground-truth boxes";
+  std::cout << std::endl;
+  return 0;
+}
+
+CommandRegistrar reg("draw", "a bird's-eye-view PNG of a scan with ground truth and detections",
+                     [](CLI::App& app) -> CommandRun {
+  auto a = std::make_shared<DrawArgs>();
+  PipelineConfig& p = a->pipeline;
+  app.add_option("--scan", a->scan, "velodyne scan (KITTI .bin, N x 4 float32)")->required()->check(CLI::ExistingFile);
+  app.add_option("--out", a->out, "PNG file to write")->required();
+  app.add_option("--labels", a->labels, "KITTI object label file (ground truth, drawn white; needs --calib)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--calib", a->calib, "KITTI calibration file (for --labels and --pred)")->check(CLI::ExistingFile);
+  app.add_option("--pred", a->pred, "KITTI object result file to draw (camera coordinates; needs --calib)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--models", p.models, "run the detector of this folder (detector.pt) on the scan");
+  app.add_option("--detector-model", p.detector_model, "run this detector model file (overrides --models)");
+  app.add_option("--detector-config", p.detector_config, "detector YAML for inference options");
+  app.add_option("--score-threshold", p.score_threshold, "minimum score (detector or --pred; default: the model's)");
+  app.add_option("--threads", p.threads, "CPU threads for libtorch")->capture_default_str();
+  app.add_option("--view", a->view, "around: the detector's grid (else 96 m x 96 m) around the sensor; front: 0-70 m "
+                 "ahead, +-40 m")->capture_default_str();
+  app.add_option("--extent", a->extent, "x_min,x_max,y_min,y_max in metres (overrides --view)");
+  app.add_option("--size", a->size, "pixels along the longer side")->capture_default_str();
+  app.add_option("--shade", a->shade, "point grey level from 'height' or 'intensity'")->capture_default_str();
+  app.add_option("--title", a->title, "first line of the legend (default: the scan's file name)");
+  app.add_flag("--no-scores", a->no_scores, "do not print each detection's score");
+  return [a]() { return runDraw(*a); };
+});
+
+}  // namespace
+}  // namespace tools
+}  // namespace ret3d
