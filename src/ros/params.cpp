@@ -6,6 +6,8 @@
 #include <sstream>
 #include <yaml-cpp/yaml.h>
 
+#include "ret3d/detector/model_file.h"
+
 namespace ret3d {
 namespace {
 
@@ -143,15 +145,20 @@ std::string defaultModelPath(const std::string& file_name) { return packagePath(
 DetectorNodeletParams loadDetectorNodeletParams(const ros::NodeHandle& private_nh) {
   const ParamReader p(private_nh);
   DetectorNodeletParams params;
-  const std::string config = p.nonEmpty("config", packagePath() + "/config/detector/lwd3d_center.yaml");
+  // An untrained network would publish noise: the nodelet always needs a model file.
+  const std::string model_path = p.nonEmpty("model_path", defaultModelPath("detector.pt"));
+  // ~config empty (the default): the config the model was trained with, stored in the model file, so an anchor-head
+  // or a centre-head model runs as it is without naming its YAML. A YAML given must describe the file's model (the
+  // detector checks it against the file when it loads the weights).
+  const std::string config = p.string("config", "");
   try {
-    params.detector = loadDetectorOptions(config);
+    params.detector = detectorOptionsForModel(model_path, config);
   } catch (const std::exception& e) {
-    throw ParamError("parameter " + p.fullName("config") + " = '" + config + "': " + e.what());
+    const std::string name = config.empty() ? "model_path" : "config";
+    throw ParamError("parameter " + p.fullName(name) + " = '" + (config.empty() ? model_path : config) +
+                     "': " + e.what());
   }
   InferenceOptions& inf = params.detector.inference;
-  // An untrained network would publish noise: the nodelet always needs a model file.
-  inf.model_path = p.nonEmpty("model_path", defaultModelPath("detector.pt"));
   inf.threads = p.integer("threads", inf.threads, 1, 64);
   inf.score_threshold = static_cast<float>(p.number("score_threshold", inf.score_threshold, 0.0, 1.0));
   inf.nms_iou = p.number("nms_iou", inf.nms_iou, 0.01, 1.0);

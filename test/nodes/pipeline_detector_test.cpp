@@ -261,6 +261,43 @@ TEST_F(DetectorNodeletTest, MissingModelIsRefused) {
   ros::param::del("/bad_detector");
 }
 
+TEST_F(DetectorNodeletTest, WithoutConfigTheModelFilesOwnConfigIsUsed) {
+  // A model saved with the config it was trained with runs without ~config (the launch file's default): an
+  // anchor-head or a centre-head model alike, whichever the default model file holds.
+  const std::string small = smallConfig(source_dir_);
+  DetectorOptions options = detectorOptionsFromYaml(small);
+  options.inference.threads = 1;
+  Detector(options).model().save(tmp_ / "with_config.pt", small);
+  ros::param::set("/own_detector/model_path", tmp_ / "with_config.pt");
+  ros::param::set("/own_detector/config", "");
+  ros::param::set("/own_detector/threads", 1);
+  nodelet::Loader loader(false);
+  EXPECT_TRUE(test::loadNodelet(loader, "/own_detector", "ret3d/DetectorNodelet")) << log_.all();
+  loader.unload("/own_detector");
+  ros::param::del("/own_detector");
+}
+
+TEST_F(DetectorNodeletTest, WithoutConfigAModelThatStoresNoneOrACorruptOneIsRefused) {
+  // detector.pt was saved without its training config: nothing to run it with.
+  ros::param::set("/bad_detector/model_path", tmp_ / "detector.pt");
+  ros::param::set("/bad_detector/config", "");
+  {
+    nodelet::Loader loader(false);
+    EXPECT_FALSE(test::loadNodelet(loader, "/bad_detector", "ret3d/DetectorNodelet"));
+  }
+  EXPECT_FALSE(log_.find({"refuses to start", "/bad_detector/model_path", "does not store the config"}).empty())
+      << log_.all();
+  // Not a model file at all.
+  std::ofstream(tmp_ / "corrupt.pt") << "not a model";
+  ros::param::set("/bad_detector/model_path", tmp_ / "corrupt.pt");
+  {
+    nodelet::Loader loader(false);
+    EXPECT_FALSE(test::loadNodelet(loader, "/bad_detector", "ret3d/DetectorNodelet"));
+  }
+  EXPECT_FALSE(log_.find({"refuses to start", "/bad_detector/model_path", "corrupt.pt"}).empty()) << log_.all();
+  ros::param::del("/bad_detector");
+}
+
 }  // namespace
 }  // namespace ret3d
 
