@@ -11,6 +11,7 @@
 // base, intra (IntraRM), track (the CenterPoint-style tracker, real ego poses), inter (tracker + InterRM), or none
 // (the boxes pass through the same conversions: the fair baseline).
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <map>
 #include <sstream>
@@ -19,8 +20,11 @@
 #include "ret3d/core/log.h"
 #include "ret3d/core/progress.h"
 #include "ret3d/eval/eval_data.h"
+#include "ret3d/eval/velocity_error.h"
 #include "ret3d/io/detections.h"
 #include "ret3d/io/kitti.h"
+#include "ret3d/io/sweeps.h"
+#include "ret3d/io/track_velocity.h"
 #include "tools/command.h"
 #include "tools/offline_pipeline.h"
 
@@ -32,8 +36,46 @@ namespace fs = std::filesystem;
 
 struct DetectArgs {
   PipelineConfig pipeline;
-  std::string data, detections, out, stages = "base", sequences;
+  std::string data, detections, out, stages = "base", sequences, velocity_report;
 };
+
+// Ground truth with velocities (from the track ids and the ego poses) of one labelled sequence, per frame.
+std::vector<eval::VelocityFrame> velocityGroundTruth(const kitti::TrackingDataset& ds, const std::string& seq,
+                                                     const kitti::Calibration& calib,
+                                                     const std::vector<Eigen::Isometry3d>& poses) {
+  std::vector<std::vector<Box>> boxes;
+  for (const kitti::Label& l : kitti::readTrackingLabels(ds.labelPath(seq))) {
+    if (l.frame < 0 || !classFromName(l.type)) continue;
+    if (static_cast<int>(boxes.size()) <= l.frame) boxes.resize(static_cast<std::size_t>(l.frame) + 1);
+    boxes[static_cast<std::size_t>(l.frame)].push_back(kitti::labelToBox(l, calib));
+  }
+  const auto valid = setTrackVelocities(&boxes, poses, 0.1);
+  std::vector<eval::VelocityFrame> out(boxes.size());
+  for (std::size_t f = 0; f < boxes.size(); ++f) out[f].gt = boxes[f], out[f].gt_valid = valid[f];
+  return out;
+}
+
+void reportVelocity(const std::vector<eval::VelocityFrame>& frames, const std::string& path) {
+  const auto stats = eval::velocityErrors(frames);
+  std::ostringstream json;
+  json << "{";
+  bool first = true;
+  for (const auto& [cls, s] : stats) {
+    std::cout << "velocity error " << className(cls) << ": moving objects (> 0.5 m/s) median " << s.moving_median
+              << " m/s, p90 " << s.moving_p90 << " m/s over " << s.moving_matched << " matched of " << s.moving_gt
+              << "; static median " << s.static_median << " m/s over " << s.static_matched << "\n";
+    json << (first ? "" : ", ") << "\"" << className(cls) << "\": {\"moving_median\": " << s.moving_median
+         << ", \"moving_p90\": " << s.moving_p90 << ", \"moving_matched\": " << s.moving_matched
+         << ", \"moving_gt\": " << s.moving_gt << ", \"static_median\": " << s.static_median
+         << ", \"static_matched\": " << s.static_matched << "}";
+    first = false;
+  }
+  json << "}\n";
+  if (!path.empty()) {
+    std::ofstream(path) << json.str();
+    std::cout << "velocity errors written to " << path << "\n";
+  }
+}
 
 Detections toDetections(const std::vector<kitti::Label>& labels, const kitti::Calibration& calib) {
   Detections d;
@@ -85,6 +127,7 @@ std::size_t detectFromScans(const DetectArgs& a, OfflinePipeline* p) {
   const std::vector<std::string> seqs = a.sequences.empty() ? ds.sequences() : eval::parseSequenceList(a.sequences);
   std::size_t total_frames = 0;
   for (const std::string& seq : seqs) total_frames += ds.frames(seq).size();
+  std::vector<eval::VelocityFrame> velocity;  // labelled sequences: predictions beside the ground truth
   ProgressBar bar("detect", total_frames);
   for (const std::string& seq : seqs) {
     const kitti::Calibration calib = kitti::readCalibration(ds.calibPath(seq));
@@ -93,28 +136,22 @@ std::size_t detectFromScans(const DetectArgs& a, OfflinePipeline* p) {
       if (p->tracks()) throw std::runtime_error("sequence " + seq + ": no ego poses (pose/ or oxts/) for tracking");
       RET3D_WARN("sequence " << seq << ": no ego poses; the previous sweep is used unmoved");
     }
-    auto pose = [&](int f) {
-      return f >= 0 && f < static_cast<int>(poses.size()) ? poses[static_cast<std::size_t>(f)]
-                                                          : Eigen::Isometry3d::Identity();
-    };
     p->reset();
+    std::vector<eval::VelocityFrame> vel;
+    if (ds.hasLabels(seq)) vel = velocityGroundTruth(ds, seq, calib, poses);
     std::vector<kitti::Label> out;
-    PointCloud previous;
-    int previous_frame = -2;
-    for (const int frame : ds.frames(seq)) {
-      const PointCloud cloud = kitti::readVelodyne(ds.velodynePath(seq, frame));
-      const bool has_prev = previous_frame == frame - 1;
-      const Eigen::Isometry3d prev_to_current = pose(frame).inverse() * pose(frame - 1);
-      const Detections d = p->run(&cloud, has_prev ? &previous : nullptr, prev_to_current, {}, 0.1 * frame, pose(frame));
+    io::forEachSweep(ds, seq, [&](const io::Sweep& s) {
+      const Detections d = p->run(s.cloud, s.previous, s.prev_to_current, {}, 0.1 * s.frame, s.pose);
       boxes += d.size();
-      const auto l = toLabels(d, calib, frame);
+      if (s.frame < static_cast<int>(vel.size())) vel[static_cast<std::size_t>(s.frame)].pred = d.boxes;
+      const auto l = toLabels(d, calib, s.frame);
       out.insert(out.end(), l.begin(), l.end());
-      previous = cloud;
-      previous_frame = frame;
       bar.tick();
-    }
+    });
     kitti::writeTrackingLabels(a.out + "/" + seq + ".txt", out);
+    velocity.insert(velocity.end(), vel.begin(), vel.end());
   }
+  if (!velocity.empty()) reportVelocity(velocity, a.velocity_report);
   return boxes;
 }
 
@@ -224,6 +261,8 @@ CommandRegistrar reg("detect", "run the pipeline offline (base detector, IntraRM
   app.add_option("--sequences", a->sequences, "tracking sequences, e.g. 16-20 (default: all)");
   app.add_option("--out", a->out, "output folder for KITTI result files")->required();
   app.add_option("--threads", p.threads, "CPU threads for libtorch")->capture_default_str();
+  app.add_option("--velocity-report", a->velocity_report,
+                 "labelled tracking data with the base stage: write the velocity errors (JSON) here");
   return [a]() { return runDetect(*a); };
 });
 

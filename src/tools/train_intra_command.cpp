@@ -8,6 +8,8 @@
 #include "ret3d/core/log.h"
 #include "ret3d/eval/eval_data.h"
 #include "ret3d/relation/intra_rm.h"
+#include "ret3d/detector/model_file.h"
+#include "ret3d/train/detector_outputs.h"
 #include "ret3d/train/intra_trainer.h"
 #include "tools/train_command.h"
 
@@ -16,7 +18,8 @@ namespace tools {
 namespace {
 
 struct TrainIntraArgs {
-  std::string data, detections, detector, out, config, sequences, val_sequences, checkpoint, inspect;
+  std::string data, detections, detector, detections_cache, out, config, sequences, val_sequences, checkpoint, inspect;
+  double score_threshold = -1;
   int epochs = -1, threads = 2;
   bool resume = false, quiet = false;
   std::string command_line;
@@ -31,10 +34,8 @@ int runTrainIntra(const TrainIntraArgs& a) {
     return 0;
   }
   if (a.data.empty() || a.out.empty()) throw std::runtime_error("--data and --out are required");
-  if (!a.detector.empty())
-    throw std::runtime_error("--detector: training on this package's detector's cached boxes and features is not "
-                             "available in this build yet; pass another detector's result files with --detections");
-  if (a.detections.empty()) throw std::runtime_error("one of --detections DIR or --detector MODEL is required");
+  if (a.detections.empty() == a.detector.empty())
+    throw std::runtime_error("give one of --detections DIR (another detector's results) or --detector MODEL");
   relation::setTorchThreads(a.threads);
   train::IntraTrainOptions opt;
   opt.config = a.config.empty() ? relation::IntraRMConfig{} : relation::loadIntraRMConfig(a.config);
@@ -45,15 +46,29 @@ int runTrainIntra(const TrainIntraArgs& a) {
   opt.progress = !a.quiet;
   opt.trained_on = a.command_line;
 
-  train::IntraDataOptions data;
-  data.data_dir = a.data;
-  data.detections_dir = a.detections;
-  if (!a.sequences.empty()) data.sequences = eval::parseSequenceList(a.sequences);
-  const auto train_frames = train::loadIntraFrames(data, opt.config.train);
-  std::vector<relation::IntraRMFrame> val_frames;
-  if (!a.val_sequences.empty()) {
-    data.sequences = eval::parseSequenceList(a.val_sequences);
-    val_frames = train::loadIntraFrames(data, opt.config.train);
+  std::vector<relation::IntraRMFrame> train_frames, val_frames;
+  if (!a.detector.empty()) {
+    // This package's detector on the scans: boxes with features, computed once and cached beside the model.
+    DetectorOptions det = detectorOptionsForModel(a.detector);
+    det.inference.threads = a.threads;
+    if (a.score_threshold >= 0) det.inference.score_threshold = a.score_threshold;
+    const std::string cache = a.detections_cache.empty() ? a.out + ".dets" : a.detections_cache;
+    auto load = [&](const std::string& list, const std::string& suffix) {
+      const std::vector<std::string> seqs = list.empty() ? std::vector<std::string>{} : eval::parseSequenceList(list);
+      return train::loadIntraFrames(a.data, train::detectSequences(a.data, seqs, det, cache + suffix), opt.config.train);
+    };
+    train_frames = load(a.sequences, "");
+    if (!a.val_sequences.empty()) val_frames = load(a.val_sequences, ".val");
+  } else {
+    train::IntraDataOptions data;
+    data.data_dir = a.data;
+    data.detections_dir = a.detections;
+    if (!a.sequences.empty()) data.sequences = eval::parseSequenceList(a.sequences);
+    train_frames = train::loadIntraFrames(data, opt.config.train);
+    if (!a.val_sequences.empty()) {
+      data.sequences = eval::parseSequenceList(a.val_sequences);
+      val_frames = train::loadIntraFrames(data, opt.config.train);
+    }
   }
   std::size_t boxes = 0, pos = 0;
   for (const auto& f : train_frames) {
@@ -76,7 +91,10 @@ TrainRegistrar reg("intra", "IntraRM (Ret3D intra-frame relation module) on anot
   app.add_option("--data", a->data, "KITTI tracking (or object) root with labels and calibration");
   app.add_option("--detections", a->detections,
                  "detector outputs: KITTI object/tracking result files or per-class CSV folders");
-  app.add_option("--detector", a->detector, "this package's detector model (boxes and features cached)");
+  app.add_option("--detector", a->detector,
+                 "this package's detector model: run on --data's scans (boxes and features, cached in OUT.dets)");
+  app.add_option("--detections-cache", a->detections_cache, "with --detector: the cache file (default OUT.dets)");
+  app.add_option("--score-threshold", a->score_threshold, "with --detector: its score threshold (default: the model's)");
   app.add_option("--out", a->out, "model file to write");
   app.add_option("--config", a->config, "IntraRM YAML config (default: built-in = config/relation/intra_rm.yaml)");
   app.add_option("--sequences", a->sequences, "training sequences, e.g. 1-15 (default: all labelled)");

@@ -9,6 +9,7 @@
 #include "ret3d/core/log.h"
 #include "ret3d/core/transform.h"
 #include "ret3d/io/kitti.h"
+#include "ret3d/io/track_velocity.h"
 
 namespace ret3d {
 
@@ -68,6 +69,8 @@ void DetectorDataset::addRoot(const std::string& root) {
       s.boxes[l.frame].push_back(b);
       s.types[l.frame].push_back(l.type);
     }
+    // Velocity targets from the same track in the previous (else the next) frame, both in the current frame.
+    s.velocity_valid = setTrackVelocities(&s.boxes, s.poses, model_.sweep_interval);
     seqs_.push_back(std::move(s));
     for (std::size_t i = 0; i < frames.size(); ++i) {
       const int prev = i > 0 && frames[i - 1] == frames[i] - 1 ? frames[i - 1] : -1;
@@ -105,34 +108,16 @@ DetectorSample DetectorDataset::load(std::size_t i) const {
     out.has_previous = true;
     out.prev_to_current = motion(s, f.previous, f.frame);
   }
-  const double dt = model_.sweep_interval;
   const auto& boxes = s.boxes[f.frame];
   for (std::size_t k = 0; k < boxes.size(); ++k) {
     const Box& b = boxes[k];
-    const std::string& type = s.types[f.frame][k];
-    if (isIgnoredType(model_, type)) {
+    if (isIgnoredType(model_, s.types[f.frame][k])) {
       out.ignore.push_back(b);
       continue;
     }
     if (!isModelClass(model_, b.label)) continue;
-    // Velocity from the same track in the previous (else the next) frame, both in the current frame.
-    Box v = b;
-    bool valid = false;
-    for (int other : {f.frame - 1, f.frame + 1}) {
-      if (valid || b.track_id == 0 || other < 0 || other >= static_cast<int>(s.boxes.size())) continue;
-      for (const Box& o : s.boxes[other]) {
-        if (o.track_id != b.track_id) continue;
-        const Eigen::Vector3d c = motion(s, other, f.frame) * o.center();
-        const double sign = other < f.frame ? 1.0 : -1.0;
-        v.vx = sign * (b.x - c.x()) / dt;
-        v.vy = sign * (b.y - c.y()) / dt;
-        valid = true;
-        break;
-      }
-    }
-    if (!valid) v.vx = v.vy = 0;
-    out.boxes.push_back(v);
-    out.velocity_valid.push_back(valid);
+    out.boxes.push_back(b);
+    out.velocity_valid.push_back(s.velocity_valid[f.frame][k]);
   }
   return out;
 }

@@ -35,13 +35,13 @@ bool inDontCare(const kitti::Label& det, const std::vector<kitti::Label>& dont_c
   return false;
 }
 
-IntraRMFrame makeFrame(const std::vector<kitti::Label>& dets, const std::vector<kitti::Label>& gt_labels,
-                       const kitti::Calibration& calib, const relation::IntraRMTrainConfig& config) {
+// The ground truth of one frame: the three classes, and Van / Person_sitting / Person as "similar" (ignored).
+relation::FrameGroundTruth groundTruth(const std::vector<kitti::Label>& gt_labels, const kitti::Calibration& calib,
+                                       std::vector<kitti::Label>* dont_care) {
   relation::FrameGroundTruth gt;
-  std::vector<kitti::Label> dont_care;
   for (const kitti::Label& l : gt_labels) {
     if (l.type == "DontCare") {
-      dont_care.push_back(l);
+      if (dont_care) dont_care->push_back(l);
     } else if (classFromName(l.type)) {
       gt.boxes.push_back(kitti::labelToBox(l, calib));
     } else if (l.type == "Van" || l.type == "Person_sitting" || l.type == "Person") {
@@ -50,6 +50,13 @@ IntraRMFrame makeFrame(const std::vector<kitti::Label>& dets, const std::vector<
       gt.similar.push_back(b);
     }
   }
+  return gt;
+}
+
+IntraRMFrame makeFrame(const std::vector<kitti::Label>& dets, const std::vector<kitti::Label>& gt_labels,
+                       const kitti::Calibration& calib, const relation::IntraRMTrainConfig& config) {
+  std::vector<kitti::Label> dont_care;
+  const relation::FrameGroundTruth gt = groundTruth(gt_labels, calib, &dont_care);
   IntraRMFrame f;
   std::vector<bool> ignore;
   for (const kitti::Label& d : dets) {
@@ -102,6 +109,30 @@ std::vector<IntraRMFrame> loadIntraFrames(const IntraDataOptions& data, const re
       IntraRMFrame f = makeFrame(dets, kitti::readObjectLabels(ds.labelPath(fr)),
                                  kitti::readCalibration(ds.calibPath(fr)), config);
       if (!f.detections.empty()) frames.push_back(std::move(f));
+    }
+  }
+  return frames;
+}
+
+std::vector<IntraRMFrame> loadIntraFrames(const std::string& data_dir, const io::SequenceDetections& detections,
+                                          const relation::IntraRMTrainConfig& config) {
+  kitti::TrackingDataset ds(data_dir);
+  std::vector<IntraRMFrame> frames;
+  for (const auto& [seq, per_frame] : detections) {
+    if (!ds.hasLabels(seq)) throw std::runtime_error("sequence " + seq + ": no labels in " + ds.dir());
+    const kitti::Calibration calib = kitti::readCalibration(ds.calibPath(seq));
+    std::map<int, std::vector<kitti::Label>> gt;
+    for (kitti::Label& l : kitti::readTrackingLabels(ds.labelPath(seq))) gt[l.frame].push_back(std::move(l));
+    for (const auto& [frame, d] : per_frame) {
+      if (d.empty()) continue;
+      const auto it = gt.find(frame);
+      // This package's boxes have no image box, so DontCare regions cannot be matched: none are ignored.
+      const relation::FrameGroundTruth truth =
+          groundTruth(it == gt.end() ? std::vector<kitti::Label>{} : it->second, calib, nullptr);
+      IntraRMFrame f;
+      f.detections = d;
+      f.targets = relation::assignIntraRMTargets(d.boxes, truth, config, std::vector<bool>(d.size(), false));
+      frames.push_back(std::move(f));
     }
   }
   return frames;

@@ -48,6 +48,7 @@ class DetectorDataset {
     std::vector<Eigen::Isometry3d> poses;       // T_velo0_velo_t, empty when absent
     std::vector<std::vector<Box>> boxes;         // per frame index: every labelled box (class Unknown for others)
     std::vector<std::vector<std::string>> types; // the KITTI type of each box
+    std::vector<std::vector<bool>> velocity_valid;  // per box: its velocity came from its track
   };
   void addRoot(const std::string& root);
   Eigen::Isometry3d motion(const Sequence& s, int from, int to) const;  // T_to_from

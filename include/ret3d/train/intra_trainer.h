@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "ret3d/io/detection_cache.h"
 #include "ret3d/relation/intra_rm_learner.h"
 
 namespace ret3d {
@@ -19,6 +20,10 @@ struct IntraDataOptions {
 // Frames with at least one detection, in LiDAR coordinates, with their targets (relation/intra_rm_targets.h).
 // Van / Person_sitting ground truth and DontCare regions become "ignore" as the KITTI benchmark treats them.
 std::vector<relation::IntraRMFrame> loadIntraFrames(const IntraDataOptions& data,
+                                                    const relation::IntraRMTrainConfig& config);
+
+// Frames from this package's detector (boxes with features, train/detector_outputs.h) on a labelled tracking dataset.
+std::vector<relation::IntraRMFrame> loadIntraFrames(const std::string& data_dir, const io::SequenceDetections& detections,
                                                     const relation::IntraRMTrainConfig& config);
 
 struct IntraTrainOptions {
