@@ -6,11 +6,16 @@
 #include <nodelet/loader.h>
 #include <ros/ros.h>
 
+#include <cstdlib>
 #include <map>
 #include <string>
 #include <vector>
 
 int main(int argc, char** argv) {
+  // Before the nodelets' library (and with it libtorch's OpenMP runtime) is loaded, which reads it once: waiting
+  // OpenMP threads sleep instead of spinning, or any other busy process on the cores slows the detector's network
+  // some 25 times (launch/ret3d.launch sets the same for its manager). A value the user set is kept.
+  setenv("OMP_WAIT_POLICY", "PASSIVE", /*overwrite=*/0);
   ros::init(argc, argv, "ret3d");
   ros::NodeHandle private_nh("~");
   bool detector = true, intra = true, inter = true;
