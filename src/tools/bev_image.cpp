@@ -142,6 +142,10 @@ BevImage::BevImage(const BevView& view) : view_(view) {
   rgb_.assign(static_cast<std::size_t>(width_) * height_ * 3, 0);
 }
 
+BevImage::BevImage(int width, int height)
+    : BevImage(BevView{0.0, static_cast<double>(std::max(1, height)), 0.0, static_cast<double>(std::max(1, width)),
+                       1.0}) {}
+
 Eigen::Vector2d BevImage::toPixel(double x, double y) const {
   return {(view_.y_max - y) * view_.pixels_per_metre, (view_.x_max - x) * view_.pixels_per_metre};
 }
@@ -165,6 +169,11 @@ void BevImage::setPixel(int col, int row, const Rgb& c) {
 void BevImage::fillRect(int col, int row, int w, int h, const Rgb& c) {
   for (int r = std::max(0, row); r < std::min(height_, row + h); ++r)
     for (int k = std::max(0, col); k < std::min(width_, col + w); ++k) setPixel(k, r, c);
+}
+
+void BevImage::paste(const BevImage& src, int col, int row) {
+  for (int r = 0; r < src.height_; ++r)
+    for (int k = 0; k < src.width_; ++k) setPixel(col + k, row + r, src.pixel(k, r));
 }
 
 void BevImage::drawPoints(const PointCloud& cloud, PointShade shade, double z_min, double z_max) {

@@ -35,6 +35,8 @@ class BevImage {
   // A black image of the view. Throws std::invalid_argument for an empty extent, a non-positive scale or a side
   // of more than 10000 pixels.
   explicit BevImage(const BevView& view);
+  // A black canvas of width x height pixels for text and composition (its view: 1 pixel per metre from the origin).
+  BevImage(int width, int height);
 
   int width() const { return width_; }
   int height() const { return height_; }
@@ -47,6 +49,8 @@ class BevImage {
   // Ignored outside the image.
   void setPixel(int col, int row, const Rgb& c);
   void fillRect(int col, int row, int w, int h, const Rgb& c);
+  // Copies `src` with its top-left corner at (col, row); what falls outside is cut off.
+  void paste(const BevImage& src, int col, int row);
 
   // One pixel per point, grey from dark to white by intensity, or by height between z_min and z_max; where several
   // points fall on one pixel the brightest wins. Points outside the view are skipped.

@@ -4,7 +4,7 @@
 // The detections come from the LWD-3D detector run in-process (--models DIR or --detector-model FILE; no calibration
 // needed, boxes stay in the LiDAR frame), or from a KITTI result file (--pred FILE, camera coordinates, needs --calib).
 //   ret3d draw --scan ../shared/data/unlabeled_scans/000010.bin --models models/lwd3d --out docs/scan.png
-//   ret3d draw --scan velodyne/000134.bin --labels label_2/000134.txt --calib calib/000134.txt \
+//   ret3d draw --scan velodyne/000134.bin --labels label_2/000134.txt --calib calib/000134.txt
 //              --models models/lwd3d --view front --out real_000134.png
 #include <algorithm>
 #include <cmath>
@@ -59,7 +59,8 @@ std::vector<double> parseExtent(const std::string& s) {
       throw std::invalid_argument("--extent: '" + item + "' is not a number (expected x_min,x_max,y_min,y_max)");
     }
   }
-  if (v.size() != 4) throw std::invalid_argument("--extent: expected 4 numbers x_min,x_max,y_min,y_max, got '" + s + "'");
+  if (v.size() != 4)
+    throw std::invalid_argument("--extent: expected 4 numbers x_min,x_max,y_min,y_max, got '" + s + "'");
   return v;
 }
 
@@ -96,16 +97,13 @@ std::vector<Box> readBoxes(const std::string& path, const kitti::Calibration& ca
   return boxes;
 }
 
-// A block of text lines on a black background at (col, row); returns the height used.
-int textBlock(BevImage& img, int col, int row, const std::vector<std::pair<std::string, Rgb>>& lines, int scale) {
-  int w = 0;
-  for (const auto& l : lines) w = std::max(w, BevImage::textWidth(l.first, scale));
-  const int line_h = BevImage::textHeight(scale) + 3 * scale;
-  const int h = static_cast<int>(lines.size()) * line_h + 2 * scale;
-  img.fillRect(col, row, w + 6 * scale, h, {0, 0, 0});
-  for (std::size_t i = 0; i < lines.size(); ++i)
-    img.drawText(col + 3 * scale, row + 3 * scale + static_cast<int>(i) * line_h, lines[i].first, lines[i].second, scale);
-  return h;
+// One line of the legend: pieces of text, each in its colour.
+using TextLine = std::vector<std::pair<std::string, Rgb>>;
+
+// Draws a line's pieces one after the other from (col, row); returns the end column.
+int drawLine(BevImage& img, int col, int row, const TextLine& line, int scale) {
+  for (const auto& [text, colour] : line) col += img.drawText(col, row, text, colour, scale) + 6 * scale;
+  return col;
 }
 
 int runDraw(DrawArgs a) {
@@ -189,7 +187,7 @@ int runDraw(DrawArgs a) {
   ego.length = 4.0;
   ego.width = 1.8;
   img.drawBox(ego, kEgo, 1, true);
-  const int thick = std::max(1, static_cast<int>(std::lround(view.pixels_per_metre / 5.0)));
+  const int thick = std::max(1, static_cast<int>(std::lround(view.pixels_per_metre / 8.0)));
   for (const Box& b : gt_other) img.drawBox(b, kOtherGt, thick, false);
   for (const Box& b : gt) img.drawBox(b, kWhite, thick + 2, false);
   std::map<ObjectClass, int> counts;
@@ -209,34 +207,41 @@ int runDraw(DrawArgs a) {
     }
   }
 
-  // Title, sources and legend top left; scale bar bottom right.
-  const int scale = img.width() >= 900 ? 2 : 1;
-  std::vector<std::pair<std::string, Rgb>> lines;
-  lines.push_back({a.title.empty() ? fs::path(a.scan).filename().string() : a.title, kText});
-  lines.push_back({std::to_string(cloud.size()) + " points, grey by " + a.shade, kText});
+  // The legend in a band above the map, so it hides nothing: title, points and scale, detections, ground truth.
+  const int scale = img.width() >= 800 ? 2 : 1;
+  std::vector<TextLine> lines;
+  lines.push_back({{a.title.empty() ? fs::path(a.scan).filename().string() : a.title, kText}});
+  lines.push_back(
+      {{std::to_string(cloud.size()) + " points, grey by " + a.shade + "; rings every 10 m; scale bar 10 m", kText}});
   if (!source.empty()) {
-    std::string s = std::to_string(dets.size()) + " detections (" + source + ")";
-    lines.push_back({s, kText});
+    lines.push_back({{std::to_string(dets.size()) + " detections (" + source + "):", kText}});
+    TextLine per_class;
     for (const ObjectClass c : kDetectedClasses)
-      lines.push_back({std::string(className(c)) + ": " + std::to_string(counts[c]), toRgb(classColour(c))});
+      per_class.push_back({std::string(className(c)) + " " + std::to_string(counts[c]) + " ", toRgb(classColour(c))});
+    lines.push_back(per_class);
   }
   if (!a.labels.empty()) {
-    lines.push_back({"ground truth: " + std::to_string(gt.size()), kWhite});
-    if (!gt_other.empty()) lines.push_back({"other labels (ignored): " + std::to_string(gt_other.size()), kOtherGt});
-    if (calib) lines.push_back({"camera view (labelled area)", kFov});
+    TextLine truth{{"ground truth " + std::to_string(gt.size()) + " ", kWhite}};
+    if (!gt_other.empty())
+      truth.push_back({"other labels, ignored " + std::to_string(gt_other.size()) + " ", kOtherGt});
+    if (calib) truth.push_back({"camera view (labelled area)", kFov});
+    lines.push_back(truth);
   }
-  textBlock(img, 0, 0, lines, scale);
-  const double bar_m = 10.0;
-  const int bar_px = static_cast<int>(std::lround(bar_m * view.pixels_per_metre));
-  const int bx = img.width() - bar_px - 10 * scale, by = img.height() - 10 * scale;
-  img.fillRect(bx - 4 * scale, by - BevImage::textHeight(scale) - 8 * scale, bar_px + 8 * scale,
-               BevImage::textHeight(scale) + 14 * scale, {0, 0, 0});
-  img.fillRect(bx, by, bar_px, scale * 2, kText);
-  img.drawText(bx, by - BevImage::textHeight(scale) - 4 * scale, "10 m, rings every 10 m", kText, 1);
+  const int line_h = BevImage::textHeight(scale) + 4 * scale;
+  BevImage page(img.width(), static_cast<int>(lines.size()) * line_h + 4 * scale + img.height());
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    const int row = 3 * scale + static_cast<int>(i) * line_h;
+    const int end = drawLine(page, 3 * scale, row, lines[i], scale);
+    if (i == 1) {  // the scale bar after "10 m:"
+      const int bar_px = static_cast<int>(std::lround(10.0 * view.pixels_per_metre));
+      page.fillRect(end, row + BevImage::textHeight(scale) / 2 - scale, bar_px, 2 * scale, kText);
+    }
+  }
+  page.paste(img, 0, page.height() - img.height());
 
   if (fs::path(a.out).has_parent_path()) fs::create_directories(fs::path(a.out).parent_path());
-  img.writePng(a.out);
-  std::cout << "draw: " << a.out << " (" << img.width() << " x " << img.height() << "), " << cloud.size()
+  page.writePng(a.out);
+  std::cout << "draw: " << a.out << " (" << page.width() << " x " << page.height() << "), " << cloud.size()
             << " points, " << dets.size() << " detections";
   if (!a.labels.empty()) std::cout << ", " << gt.size() << " ground-truth boxes";
   std::cout << std::endl;
