@@ -9,6 +9,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <random>
 #include <thread>
 
 #include <rosbag/bag.h>
@@ -29,7 +30,7 @@ namespace fs = std::filesystem;
 
 struct BenchArgs {
   PipelineConfig pipeline;
-  std::string data, bag, topic, stages = "base,intra,track,inter", json, sequence;
+  std::string data, bag, topic, stages = "base,intra,track,inter", json, sequence, objects = "50,300";
   int warmup = 5, min_runs = 100, max_frames = 200;
 };
 
@@ -105,6 +106,27 @@ std::vector<BenchFrame> framesFromBag(const BenchArgs& a) {
   return out;
 }
 
+// A synthetic frame of n objects over sx x sy metres in front of the sensor: KITTI-like when spread over 70 x 80 m,
+// pessimistic (many edges) when crowded into 30 x 30 m.
+Detections layout(int n, double sx, double sy, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(0, 1);
+  Detections d;
+  for (int i = 0; i < n; ++i) {
+    Box b;
+    b.label = kDetectedClasses[static_cast<std::size_t>(i % 3)];
+    b.length = b.label == ObjectClass::Car ? 3.9 : b.label == ObjectClass::Pedestrian ? 0.8 : 1.8;
+    b.width = b.label == ObjectClass::Car ? 1.6 : 0.6;
+    b.height = b.label == ObjectClass::Car ? 1.5 : 1.7;
+    b.x = sx * u(rng);
+    b.y = sy * (u(rng) - 0.5);
+    b.z = -0.9;
+    b.yaw = M_PI * (2 * u(rng) - 1);
+    b.score = static_cast<float>(u(rng));
+    d.boxes.push_back(b);
+  }
+  return d;
+}
+
 struct Summary {
   double median = 0, p95 = 0;
 };
@@ -118,12 +140,59 @@ Summary summarise(std::vector<double> v) {
   return s;
 }
 
+void printRow(const std::string& name, const Summary& s, std::ostringstream* json, bool* first) {
+  std::cout << std::left << std::setw(26) << name << std::right << std::fixed << std::setprecision(3) << std::setw(12)
+            << s.median << std::setw(12) << s.p95 << "\n";
+  *json << (*first ? "" : ", ") << "\"" << name << "\": {\"median_ms\": " << s.median << ", \"p95_ms\": " << s.p95
+        << "}";
+  *first = false;
+}
+
+void writeJson(const std::string& path, const std::string& text) {
+  if (path.empty()) return;
+  if (fs::path(path).has_parent_path()) fs::create_directories(fs::path(path).parent_path());
+  std::ofstream(path) << text;
+  std::cout << "bench: wrote " << path << "\n";
+}
+
+// `--stages intra` alone: IntraRM's refine() per frame for given object counts on synthetic layouts (the graph is
+// built inside), so its cost is known for crowded scenes no drive provides.
+int benchIntraAlone(const BenchArgs& a) {
+  OfflinePipeline p(a.pipeline);
+  std::cout << "bench: " << p.describe() << "; " << a.pipeline.threads << " threads, " << a.warmup
+            << " warm-up and " << a.min_runs << " timed runs per case\n";
+  std::cout << std::left << std::setw(26) << "case" << std::right << std::setw(12) << "median ms" << std::setw(12)
+            << "p95 ms" << "\n";
+  std::ostringstream json;
+  json << "{";
+  bool first = true;
+  std::mt19937 rng(1);
+  const Eigen::Isometry3d I = Eigen::Isometry3d::Identity();
+  std::stringstream ss(a.objects);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    const int n = std::stoi(item);
+    for (const bool crowded : {false, true}) {
+      const Detections d = crowded ? layout(n, 30, 30, rng) : layout(n, 70, 80, rng);
+      for (int k = 0; k < a.warmup; ++k) p.run(nullptr, nullptr, I, d, 0, I);
+      p.clearTimes();
+      for (int k = 0; k < a.min_runs; ++k) p.run(nullptr, nullptr, I, d, 0, I);
+      printRow("intra_" + std::to_string(n) + (crowded ? "_crowded" : "_spread"), summarise(p.times().all().at("intra")),
+               &json, &first);
+    }
+  }
+  json << "}\n";
+  writeJson(a.json, json.str());
+  return 0;
+}
+
 int runBench(BenchArgs a) {
-  if (a.data.empty() == a.bag.empty()) throw std::runtime_error("give exactly one of --data DIR and --bag FILE");
   a.pipeline.stages = parseStages(a.stages);
+  if (a.pipeline.stages == std::vector<std::string>{"intra"}) return benchIntraAlone(a);
+  if (a.data.empty() == a.bag.empty()) throw std::runtime_error("give exactly one of --data DIR and --bag FILE");
   if (a.pipeline.stages.empty() || a.pipeline.stages.front() != "base")
-    throw std::runtime_error("--stages must start with base: the bench runs on point clouds (bench-intra times "
-                             "IntraRM alone on synthetic layouts)");
+    throw std::runtime_error("--stages must start with base (the bench runs on point clouds), or be intra alone "
+                             "(synthetic layouts of --objects objects)");
   const std::vector<BenchFrame> frames = a.bag.empty() ? framesFromData(a) : framesFromBag(a);
   if (frames.empty()) throw std::runtime_error("no frames to time");
   OfflinePipeline p(a.pipeline);
@@ -151,28 +220,19 @@ int runBench(BenchArgs a) {
     ++pass;
   }
   const auto& t = p.times().all();
-  std::cout << std::left << std::setw(10) << "stage" << std::right << std::setw(12) << "median ms" << std::setw(12)
+  std::cout << std::left << std::setw(26) << "stage" << std::right << std::setw(12) << "median ms" << std::setw(12)
             << "p95 ms" << "\n";
   std::ostringstream json;
   json << "{";
   bool first = true;
-  for (const char* stage : {"bev", "network", "decode", "nms", "intra", "track", "inter", "total"}) {
-    if (!t.count(stage)) continue;
-    const Summary s = summarise(t.at(stage));
-    std::cout << std::left << std::setw(10) << stage << std::right << std::fixed << std::setprecision(3)
-              << std::setw(12) << s.median << std::setw(12) << s.p95 << "\n";
-    json << (first ? "" : ", ") << "\"" << stage << "\": {\"median_ms\": " << s.median << ", \"p95_ms\": " << s.p95
-         << "}";
-    first = false;
-  }
+  for (const char* stage : {"bev", "network", "decode", "nms", "intra", "track", "inter", "total"})
+    if (t.count(stage)) printRow(stage, summarise(t.at(stage)), &json, &first);
   // The base detector alone (BEV + network + decoding + NMS), the figure of the latency budget.
   std::vector<double> base;
   for (std::size_t i = 0; i < t.at("bev").size(); ++i)
     base.push_back(t.at("bev")[i] + t.at("network")[i] + t.at("decode")[i] + t.at("nms")[i]);
-  const Summary sb = summarise(base);
-  std::cout << std::left << std::setw(10) << "base" << std::right << std::setw(12) << sb.median << std::setw(12) << sb.p95
-            << "   (bev + network + decode + nms)\n";
-  json << ", \"base\": {\"median_ms\": " << sb.median << ", \"p95_ms\": " << sb.p95 << "}";
+  printRow("base", summarise(base), &json, &first);
+  std::cout << "(base = bev + network + decode + nms)\n";
   const Detector* det = p.detector();
   const std::string model = det->options().inference.model_path;
   std::cout << "detector: " << det->parameterCount() << " parameters, model file " << fs::file_size(model)
@@ -180,11 +240,7 @@ int runBench(BenchArgs a) {
   json << ", \"parameters\": " << det->parameterCount() << ", \"model_bytes\": " << fs::file_size(model)
        << ", \"frames\": " << frames.size() << ", \"runs\": " << a.min_runs << ", \"threads\": " << a.pipeline.threads
        << "}\n";
-  if (!a.json.empty()) {
-    if (fs::path(a.json).has_parent_path()) fs::create_directories(fs::path(a.json).parent_path());
-    std::ofstream(a.json) << json.str();
-    std::cout << "bench: wrote " << a.json << "\n";
-  }
+  writeJson(a.json, json.str());
   return 0;
 }
 
@@ -206,6 +262,8 @@ CommandRegistrar reg("bench", "time each pipeline stage over real scans (median 
   app.add_option("--warmup", a->warmup, "untimed runs first")->capture_default_str();
   app.add_option("--min-runs", a->min_runs, "timed runs (frames are cycled)")->capture_default_str();
   app.add_option("--max-frames", a->max_frames, "frames read at most")->capture_default_str();
+  app.add_option("--objects", a->objects, "--stages intra alone: object counts of the synthetic frames")
+      ->capture_default_str();
   app.add_option("--json", a->json, "write {\"<stage>\": {\"median_ms\", \"p95_ms\"}, ..., \"total\": {...}}");
   return [a]() { return runBench(*a); };
 });

@@ -271,7 +271,7 @@ TEST(IntraRM, LoaderRefusesBadFilesAndMismatchesWithAMessage) {
   EXPECT_NO_THROW(IntraRM{o});
 }
 
-// Cost is reported, not asserted (the machine is shared): see `ret3d bench-intra` for the figures.
+// Cost is reported, not asserted (the machine is shared): see `ret3d bench --stages intra` for the figures.
 TEST(IntraRM, ReportsRefineTimeForFiftyAndThreeHundredObjects) {
   const IntraRM& m = trainedModule();
   std::mt19937 rng(13);

@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# Evaluates the pipeline on the held-out simulated set of the model card: urban, HDL-64E, 5 sequences x 100 frames,
+# seeds 9000-9004 (never used for training: those are 1000-1031 urban, 2000-2007 highway, 3000-3011 relation
+# modules, 5000-5001 validation).
+#   scripts/eval_heldout.sh [STAGES] [NAME] [extra ret3d detect options...]
+#   scripts/eval_heldout.sh base base --models models/lwd3d
+#   scripts/eval_heldout.sh base,intra intra --models models/lwd3d
+# Writes out/heldout/NAME/{pred,eval,velocity.json,detect.log} and prints the headline figures.
+set -eo pipefail
+cd "$(dirname "$0")/.."
+STAGES=${1:-base}
+NAME=${2:-$STAGES}
+shift 2 || true
+[ $# -gt 0 ] || set -- --models models/lwd3d
+set +u
+source scripts/env.sh
+set -u
+DATA=data/sim_test_urban
+if [ ! -f "$DATA/.done" ]; then
+  rm -rf "$DATA"
+  ret3d sim --config config/sim/urban_street.yaml --out "$DATA" --sequences 5 --frames 100 --seed 9000
+  touch "$DATA/.done"
+fi
+OUT=out/heldout/$NAME
+rm -rf "$OUT"
+mkdir -p "$OUT"
+ret3d detect --data "$DATA" --stages "$STAGES" --out "$OUT/pred" --velocity-report "$OUT/velocity.json" "$@" \
+  2>&1 | tr '\r' '\n' | grep -v "^detect .*it/s" | tee "$OUT/detect.log"
+metrics=kitti,waymo
+case "$STAGES" in *track*|*inter*) metrics=kitti,waymo,mot ;; esac
+ret3d eval --gt "$DATA" --pred "$OUT/pred" --out "$OUT/eval" --metric "$metrics" >"$OUT/eval.log" 2>&1
+python3 - "$OUT" <<'PY'
+import json, sys
+out = sys.argv[1]
+m = json.load(open(out + "/eval/metrics.json"))
+classes = ("Car", "Pedestrian", "Cyclist")
+print("%-11s %8s %8s %8s %9s %9s" % ("class", "3D R40", "BEV R40", "L1 APH", "L2 AP", "L2 APH"))
+for c in classes:
+    print("%-11s %8.2f %8.2f %8.2f %9.2f %9.2f" % (c, m["kitti.%s.3d.R40.moderate" % c], m["kitti.%s.bev.R40.moderate" % c],
+          m["waymo.%s.L1.APH" % c], m["waymo.%s.L2.AP" % c], m["waymo.%s.L2.APH" % c]))
+print("mean        %8.2f %8.2f %8.2f %9.2f %9.2f" % (sum(m["kitti.%s.3d.R40.moderate" % c] for c in classes) / 3,
+      sum(m["kitti.%s.bev.R40.moderate" % c] for c in classes) / 3, m["waymo.mean.L1.APH"], m["waymo.mean.L2.AP"],
+      m["waymo.mean.L2.APH"]))
+for k in sorted(m):
+    if k.startswith("mot.") and (k.endswith(".MOTA") or k.endswith(".IDSW") or k.endswith(".HOTA")):
+        print("%s %.2f" % (k, m[k]))
+print("(KITTI 3D/BEV AP R40 at moderate difficulty, Car @0.7, Pedestrian/Cyclist @0.5; report " + out + "/eval/report.md)")
+PY
