@@ -6,6 +6,10 @@
 
 #include "tools/train_command.h"
 
+#include "ret3d/detector/model_file.h"
+#include "ret3d/eval/eval_data.h"
+#include "ret3d/train/detector_outputs.h"
+
 namespace ret3d {
 namespace tools {
 
@@ -35,5 +39,22 @@ CommandRun setupTrain(CLI::App& app) {
 CommandRegistrar reg("train", "train a learned stage (detector, ...) on KITTI-layout data", setupTrain);
 
 }  // namespace
+void DetectorSource::addOptions(CLI::App& app) {
+  app.add_option("--detector", model,
+                 "this package's detector model: run on --data's scans (boxes and features, cached in OUT.dets)");
+  app.add_option("--detections-cache", cache, "with --detector: the cache file (default OUT.dets)");
+  app.add_option("--score-threshold", score_threshold, "with --detector: its score threshold (default: the model's)");
+}
+
+io::SequenceDetections DetectorSource::run(const std::string& data, const std::string& sequences, int threads,
+                                           const std::string& default_cache, const std::string& suffix) const {
+  DetectorOptions det = detectorOptionsForModel(model);
+  det.inference.threads = threads;
+  if (score_threshold >= 0) det.inference.score_threshold = score_threshold;
+  const std::vector<std::string> seqs =
+      sequences.empty() ? std::vector<std::string>{} : eval::parseSequenceList(sequences);
+  return train::detectSequences(data, seqs, det, (cache.empty() ? default_cache : cache) + suffix);
+}
+
 }  // namespace tools
 }  // namespace ret3d

@@ -20,6 +20,7 @@ namespace {
 
 struct TrainInterArgs {
   std::string data, detections, intra_model, tracker_config, out, config, sequences, val_sequences, checkpoint, inspect;
+  DetectorSource detector;
   int epochs = -1, threads = 2;
   bool resume = false, quiet = false;
   std::string command_line;
@@ -34,7 +35,8 @@ int runTrainInter(const TrainInterArgs& a) {
     return 0;
   }
   if (a.data.empty() || a.out.empty()) throw std::runtime_error("--data and --out are required");
-  if (a.detections.empty()) throw std::runtime_error("--detections DIR is required (another detector's boxes)");
+  if (a.detections.empty() == !a.detector.given())
+    throw std::runtime_error("give one of --detections DIR (another detector's results) or --detector MODEL");
   relation::setTorchThreads(a.threads);
   train::InterTrainOptions opt;
   opt.config = a.config.empty() ? relation::InterRMConfig{} : relation::loadInterRMConfig(a.config);
@@ -53,13 +55,18 @@ int runTrainInter(const TrainInterArgs& a) {
   if (data.tracker.history_length < opt.config.model.max_history)
     RET3D_WARN("the tracker keeps " << data.tracker.history_length << " boxes per track, InterRM could use "
                                     << opt.config.model.max_history);
-  if (!a.sequences.empty()) data.sequences = eval::parseSequenceList(a.sequences);
-  const auto train_samples = train::loadInterSamples(data, opt.config.train);
+  auto load = [&](const std::string& list, const std::string& suffix) {
+    data.sequences = list.empty() ? std::vector<std::string>{} : eval::parseSequenceList(list);
+    io::SequenceDetections own;  // this package's detector's boxes and features, when --detector is given
+    if (a.detector.given()) {
+      own = a.detector.run(a.data, list, a.threads, a.out + ".dets", suffix);
+      data.detector_outputs = &own;
+    }
+    return train::loadInterSamples(data, opt.config.train);
+  };
+  const auto train_samples = load(a.sequences, "");
   std::vector<relation::InterRMSample> val_samples;
-  if (!a.val_sequences.empty()) {
-    data.sequences = eval::parseSequenceList(a.val_sequences);
-    val_samples = train::loadInterSamples(data, opt.config.train);
-  }
+  if (!a.val_sequences.empty()) val_samples = load(a.val_sequences, ".val");
   double mean_len = 0;
   for (const auto& s : train_samples) mean_len += static_cast<double>(s.sequence.boxes.size());
   if (!train_samples.empty()) mean_len /= static_cast<double>(train_samples.size());
@@ -81,6 +88,7 @@ TrainRegistrar reg("inter", "InterRM (Ret3D inter-frame relation module) on trac
   app.add_option("--data", a->data, "KITTI tracking root with labels, calibration and poses (pose/ or oxts/)");
   app.add_option("--detections", a->detections,
                  "detector outputs: KITTI tracking result files or per-class CSV folders");
+  a->detector.addOptions(app);
   app.add_option("--intra-model", a->intra_model, "IntraRM model run on each frame before tracking (optional)");
   app.add_option("--tracker-config", a->tracker_config, "tracker YAML (default: built-in = config/tracker.yaml)");
   app.add_option("--out", a->out, "model file to write");

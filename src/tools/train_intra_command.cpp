@@ -8,8 +8,6 @@
 #include "ret3d/core/log.h"
 #include "ret3d/eval/eval_data.h"
 #include "ret3d/relation/intra_rm.h"
-#include "ret3d/detector/model_file.h"
-#include "ret3d/train/detector_outputs.h"
 #include "ret3d/train/intra_trainer.h"
 #include "tools/train_command.h"
 
@@ -18,8 +16,8 @@ namespace tools {
 namespace {
 
 struct TrainIntraArgs {
-  std::string data, detections, detector, detections_cache, out, config, sequences, val_sequences, checkpoint, inspect;
-  double score_threshold = -1;
+  std::string data, detections, out, config, sequences, val_sequences, checkpoint, inspect;
+  DetectorSource detector;
   int epochs = -1, threads = 2;
   bool resume = false, quiet = false;
   std::string command_line;
@@ -34,7 +32,7 @@ int runTrainIntra(const TrainIntraArgs& a) {
     return 0;
   }
   if (a.data.empty() || a.out.empty()) throw std::runtime_error("--data and --out are required");
-  if (a.detections.empty() == a.detector.empty())
+  if (a.detections.empty() == !a.detector.given())
     throw std::runtime_error("give one of --detections DIR (another detector's results) or --detector MODEL");
   relation::setTorchThreads(a.threads);
   train::IntraTrainOptions opt;
@@ -47,15 +45,11 @@ int runTrainIntra(const TrainIntraArgs& a) {
   opt.trained_on = a.command_line;
 
   std::vector<relation::IntraRMFrame> train_frames, val_frames;
-  if (!a.detector.empty()) {
+  if (a.detector.given()) {
     // This package's detector on the scans: boxes with features, computed once and cached beside the model.
-    DetectorOptions det = detectorOptionsForModel(a.detector);
-    det.inference.threads = a.threads;
-    if (a.score_threshold >= 0) det.inference.score_threshold = a.score_threshold;
-    const std::string cache = a.detections_cache.empty() ? a.out + ".dets" : a.detections_cache;
     auto load = [&](const std::string& list, const std::string& suffix) {
-      const std::vector<std::string> seqs = list.empty() ? std::vector<std::string>{} : eval::parseSequenceList(list);
-      return train::loadIntraFrames(a.data, train::detectSequences(a.data, seqs, det, cache + suffix), opt.config.train);
+      return train::loadIntraFrames(a.data, a.detector.run(a.data, list, a.threads, a.out + ".dets", suffix),
+                                    opt.config.train);
     };
     train_frames = load(a.sequences, "");
     if (!a.val_sequences.empty()) val_frames = load(a.val_sequences, ".val");
@@ -91,10 +85,7 @@ TrainRegistrar reg("intra", "IntraRM (Ret3D intra-frame relation module) on anot
   app.add_option("--data", a->data, "KITTI tracking (or object) root with labels and calibration");
   app.add_option("--detections", a->detections,
                  "detector outputs: KITTI object/tracking result files or per-class CSV folders");
-  app.add_option("--detector", a->detector,
-                 "this package's detector model: run on --data's scans (boxes and features, cached in OUT.dets)");
-  app.add_option("--detections-cache", a->detections_cache, "with --detector: the cache file (default OUT.dets)");
-  app.add_option("--score-threshold", a->score_threshold, "with --detector: its score threshold (default: the model's)");
+  a->detector.addOptions(app);
   app.add_option("--out", a->out, "model file to write");
   app.add_option("--config", a->config, "IntraRM YAML config (default: built-in = config/relation/intra_rm.yaml)");
   app.add_option("--sequences", a->sequences, "training sequences, e.g. 1-15 (default: all labelled)");

@@ -66,7 +66,9 @@ std::vector<Box> TrackingRefiner::update(const std::vector<Box>& detections, dou
 
 std::vector<InterRMSample> loadInterSamples(const InterDataOptions& data, const relation::InterRMTrainConfig& config) {
   namespace fs = std::filesystem;
-  const io::DetectionLayout layout = io::detectDetectionLayout(data.detections_dir);
+  const bool from_files = data.detector_outputs == nullptr;
+  const io::DetectionLayout layout =
+      from_files ? io::detectDetectionLayout(data.detections_dir) : io::DetectionLayout::KittiTracking;
   if (layout == io::DetectionLayout::KittiObject)
     throw std::runtime_error("detections " + data.detections_dir +
                              " are per-frame object result files; InterRM needs sequences (tracking result files or "
@@ -98,7 +100,15 @@ std::vector<InterRMSample> loadInterSamples(const InterDataOptions& data, const 
     std::map<int, relation::FrameGroundTruth> gt;
     for (const kitti::Label& l : kitti::readTrackingLabels(ds.labelPath(seq)))
       if (classFromName(l.type)) gt[l.frame].boxes.push_back(kitti::labelToBox(l, calib));
-    const auto dets = io::readSequenceDetections(data.detections_dir, layout, seq);
+    // Per frame: another detector's result files, or this package's detector's outputs (boxes with features).
+    std::map<int, Detections> dets;
+    if (from_files) {
+      for (const auto& [frame, labels] : io::readSequenceDetections(data.detections_dir, layout, seq))
+        for (const kitti::Label& l : labels)
+          if (classFromName(l.type)) dets[frame].boxes.push_back(kitti::labelToBox(l, calib));
+    } else if (const auto it = data.detector_outputs->find(seq); it != data.detector_outputs->end()) {
+      dets = it->second;
+    }
     int last = static_cast<int>(poses.size()) - 1;
     if (!dets.empty() && dets.rbegin()->first > last)
       throw std::runtime_error("sequence " + seq + ": detections up to frame " + std::to_string(dets.rbegin()->first) +
@@ -106,9 +116,7 @@ std::vector<InterRMSample> loadInterSamples(const InterDataOptions& data, const 
     GreedyTracker tracker(data.tracker);
     for (int f = 0; f <= last; ++f) {
       Detections d;
-      if (auto it = dets.find(f); it != dets.end())
-        for (const kitti::Label& l : it->second)
-          if (classFromName(l.type)) d.boxes.push_back(kitti::labelToBox(l, calib));
+      if (auto it = dets.find(f); it != dets.end()) d = it->second;
       if (intra && !d.empty()) d = intra->refine(d);
       const std::vector<Box> tracked =
           tracker.update(d.boxes, f * data.frame_period, poses[static_cast<std::size_t>(f)]);

@@ -9,6 +9,7 @@
 
 #include <Eigen/Geometry>
 
+#include "ret3d/io/detection_cache.h"
 #include "ret3d/relation/inter_rm.h"
 #include "ret3d/relation/inter_rm_learner.h"
 #include "ret3d/tracking/greedy_tracker.h"
@@ -46,6 +47,7 @@ class TrackingRefiner {
 struct InterDataOptions {
   std::string data_dir;        // KITTI tracking root (label_02, calib, pose or oxts)
   std::string detections_dir;  // detector outputs (KITTI tracking result files or the per-class CSV layout)
+  const io::SequenceDetections* detector_outputs = nullptr;  // instead: this package's detector's (detector_outputs.h)
   std::vector<std::string> sequences;  // empty = every sequence with labels
   std::string intra_model;     // optional IntraRM model run on each frame before tracking
   TrackerOptions tracker;
