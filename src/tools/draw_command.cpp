@@ -140,7 +140,8 @@ int runDraw(DrawArgs a) {
     view.y_max = g.y_max;
     const std::string model = a.pipeline.detector_model.empty() ? a.pipeline.models + "/detector.pt"
                                                                 : a.pipeline.detector_model;
-    source = "LWD-3D " + fs::path(model).lexically_normal().string() + ", score >= " +
+    const fs::path m(model);  // its folder and name say which model it is (models/lwd3d/detector.pt -> lwd3d/...)
+    source = "LWD-3D " + (m.parent_path().filename() / m.filename()).string() + ", score >= " +
              fixed(p.detector()->options().inference.score_threshold, 2);
   } else if (!a.pred.empty()) {
     dets = readBoxes(a.pred, *calib, nullptr);
@@ -218,6 +219,7 @@ int runDraw(DrawArgs a) {
     TextLine per_class;
     for (const ObjectClass c : kDetectedClasses)
       per_class.push_back({std::string(className(c)) + " " + std::to_string(counts[c]) + " ", toRgb(classColour(c))});
+    per_class.push_back({"(line from centre: heading)", kOtherGt});
     lines.push_back(per_class);
   }
   if (!a.labels.empty()) {
