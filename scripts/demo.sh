@@ -4,7 +4,7 @@
 # default models (launch/replay.launch: detector, IntraRM, tracker, InterRM and markers in one nodelet manager, with
 # simulated time), records /objects, scores them against the bag's ground truth (ret3d eval) and prints a summary.
 #
-# Usage: scripts/demo.sh [--rviz] [--bag FILE] [--models DIR] [--rate R] [--out DIR] [--no-setup]
+# Usage: scripts/demo.sh [--rviz] [--bag FILE] [--models DIR] [--rate R] [--out DIR] [--no-setup] [--screenshot PNG]
 #   --rviz        watch it in rviz (needs a display); headless without it
 #   --bag FILE    replay your own bag instead (PointCloud2 on /points, tf from `odom` to the cloud's frame); scored
 #                 only when it has /ground_truth/objects (ret3d/Object3DArray)
@@ -13,14 +13,16 @@
 #   --rate R      playback rate (default 1: real time)
 #   --out DIR     where the outputs go (default out/demo): objects.bag, replay.log, report/, summary.txt
 #   --no-setup    skip scripts/setup.sh (the package is built already)
+#   --screenshot PNG  rviz on a virtual display (Xvfb), photographed halfway through the replay (docs/demo_rviz.png
+#                 was made so, with --rate 0.5: rviz's software rendering needs the cores too)
 # The replay runs on a ROS master of its own (a free port), so a roscore already running is left alone.
 # Exits non-zero, saying why, when a step fails.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$(pwd)
 
-RVIZ=false BAG="" MODELS="$ROOT/models/lwd3d" RATE=1.0 OUT="$ROOT/out/demo" SETUP=true
-usage() { sed -n '7,17p' "$0" | sed 's/^# \{0,1\}//'; }
+RVIZ=false BAG="" MODELS="$ROOT/models/lwd3d" RATE=1.0 OUT="$ROOT/out/demo" SETUP=true SHOT=""
+usage() { sed -n '7,19p' "$0" | sed 's/^# \{0,1\}//'; }
 while (($#)); do
   case "$1" in
     --rviz) RVIZ=true ;;
@@ -29,6 +31,7 @@ while (($#)); do
     --rate) RATE=${2:?--rate needs a number}; shift ;;
     --out) OUT=$(realpath -m "${2:?--out needs a folder}"); shift ;;
     --no-setup) SETUP=false ;;
+    --screenshot) SHOT=$(realpath -m "${2:?--screenshot needs a file}"); shift ;;
     -h|--help) usage; exit 0 ;;
     *) echo "demo: unknown argument '$1'" >&2; usage >&2; exit 2 ;;
   esac
@@ -37,7 +40,7 @@ done
 say() { echo "demo: $*"; }
 fail() { echo "demo: $*" >&2; exit 1; }
 
-if $RVIZ && [[ -z "${DISPLAY:-}" ]]; then fail "--rviz needs a display (DISPLAY is not set)"; fi
+if [[ -z "$SHOT" ]] && $RVIZ && [[ -z "${DISPLAY:-}" ]]; then fail "--rviz needs a display (DISPLAY is not set)"; fi
 if [[ -n "$BAG" && ! -f "$BAG" ]]; then fail "no bag at $BAG"; fi
 
 if $SETUP; then scripts/setup.sh; fi
@@ -73,6 +76,17 @@ if [[ -z "$BAG" ]]; then
   fi
 fi
 
+# For --screenshot: rviz on a virtual display of its own, with software OpenGL.
+if [[ -n "$SHOT" ]]; then
+  command -v Xvfb >/dev/null && command -v import >/dev/null || fail "--screenshot needs Xvfb and imagemagick"
+  for SCREEN in $(seq 90 120); do [[ -e /tmp/.X$SCREEN-lock || -e /tmp/.X11-unix/X$SCREEN ]] || break; done
+  Xvfb ":$SCREEN" -screen 0 1280x720x24 -nolisten tcp >"$OUT/xvfb.log" 2>&1 &
+  XVFB=$!
+  trap 'kill "$XVFB" 2>/dev/null || true' EXIT
+  export DISPLAY=":$SCREEN" LIBGL_ALWAYS_SOFTWARE=1
+  RVIZ=true
+fi
+
 # The replay, on a master of its own; ROS logs under OUT.
 PORT=$(python3 -c 'import socket; s = socket.socket(); s.bind(("localhost", 0)); print(s.getsockname()[1])')
 export ROS_MASTER_URI="http://localhost:$PORT" ROS_HOME="$OUT/ros_home"
@@ -80,6 +94,12 @@ DURATION=$(rosbag info --yaml --key=duration "$BAG")
 LIMIT=$(python3 -c "print(int(120 + float('$DURATION') / float('$RATE')))")
 rm -f "$OUT/objects.bag" "$OUT/objects.bag.active"
 say "replaying $BAG ($(printf %.1f "$DURATION") s at rate $RATE) through $STAGES; log: $OUT/replay.log"
+if [[ -n "$SHOT" ]]; then
+  # The player starts about 4 s after the launch (model loading, replay.launch's delay); then half the drive.
+  (sleep "$(python3 -c "print(5 + float('$DURATION') / float('$RATE') / 2)")"
+   import -display "$DISPLAY" -window root "$SHOT" >>"$OUT/xvfb.log" 2>&1) &
+  SHOOTER=$!
+fi
 rc=0
 timeout --signal=INT --kill-after=20 "$LIMIT" roslaunch ret3d replay.launch bag:="$BAG" record:="$OUT/objects.bag" \
   rate:="$RATE" rviz:="$RVIZ" intra:="$INTRA" inter:="$INTER" detector_model:="$DETECTOR" \
@@ -93,6 +113,11 @@ if ((rc == 124)); then fail "the replay did not end within $LIMIT s (log: $OUT/r
 if ((rc != 0)) || [[ ! -f "$OUT/objects.bag" ]]; then
   sed 's/\x1b\[[0-9;]*m//g' "$OUT/replay.log" | grep -E "ERROR|FATAL|died|Error" | head -20 >&2 || true
   fail "the replay failed (roslaunch exit status $rc; log: $OUT/replay.log)"
+fi
+
+if [[ -n "$SHOT" ]]; then
+  wait "$SHOOTER" && [[ -f "$SHOT" ]] || fail "no screenshot taken (log: $OUT/xvfb.log)"
+  say "rviz screenshot: $SHOT"
 fi
 
 # The scores, when the bag has ground truth.
