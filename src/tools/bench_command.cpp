@@ -181,6 +181,11 @@ int benchSynthetic(const BenchArgs& a) {
         const double v = b.label == ObjectClass::Car ? 10 : b.label == ObjectClass::Cyclist ? 5 : 1.5;
         b.vx = v * speed(rng), b.vy = v * speed(rng);
       }
+      // An IntraRM trained on detector features gets random ones of its length (the cost does not depend on them).
+      d.feature_dim = p.intraFeatureDim();
+      std::normal_distribution<float> feature(0.0f, 1.0f);
+      d.features.resize(d.boxes.size() * d.feature_dim);
+      for (float& x : d.features) x = feature(rng);
       p.reset();
       ++cases;
       // Warm-up frames fill the track histories first (the cost grows with their length).

@@ -94,6 +94,8 @@ OfflinePipeline::~OfflinePipeline() = default;
 
 std::string OfflinePipeline::describe() const { return description_; }
 
+std::size_t OfflinePipeline::intraFeatureDim() const { return intra_ ? intra_->arch().feature_dim : 0; }
+
 void OfflinePipeline::reset() {
   if (tracking_) tracking_->reset();
 }

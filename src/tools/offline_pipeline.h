@@ -53,6 +53,8 @@ class OfflinePipeline {
   bool hasBase() const { return static_cast<bool>(detector_); }
   bool tracks() const { return static_cast<bool>(tracking_); }
   const Detector* detector() const { return detector_.get(); }
+  // Length of the detector features IntraRM expects with each box (0: none, or no IntraRM stage).
+  std::size_t intraFeatureDim() const;
   std::string describe() const;  // the stages and the model files, one line
 
   // A new sequence: the tracker forgets its tracks.
