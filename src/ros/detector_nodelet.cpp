@@ -4,6 +4,8 @@
 // without intensity or with NaN points (from the conversion report), an empty or malformed cloud (empty detections
 // published), a missing transform (previous sweep used without motion compensation), stamps going backwards or a gap
 // longer than ~max_sweep_gap (previous sweep dropped).
+#include <chrono>
+#include <cmath>
 #include <pluginlib/class_list_macros.hpp>
 #include <sensor_msgs/PointCloud2.h>
 
@@ -26,9 +28,27 @@ class DetectorNodelet : public StageNodelet<sensor_msgs::PointCloud2> {
     params_ = loadDetectorNodeletParams(getPrivateNodeHandle());
     detector_ = constructStage(getPrivateNodeHandle(), "model_path", params_.detector.inference.model_path,
                                [&] { return std::make_unique<Detector>(params_.detector); });
+    warmUp();
     poses_ = std::make_unique<PoseSource>(params_.pose, getNodeHandle());
     publisher_ = getNodeHandle().advertise<ret3d::DetectionArray>("detections", 1);
     start("points");
+  }
+
+  // The first inferences of a freshly loaded network are several times slower (allocations, thread pools, BLAS
+  // set-up): run them now on a synthetic scan of the usual size, so the first real clouds are not late.
+  void warmUp() {
+    PointCloud cloud;
+    cloud.points.reserve(120000);
+    for (int i = 0; i < 120000; ++i) {
+      const double a = 2 * M_PI * (i % 2000) / 2000.0, r = 3.0 + 0.5 * (i / 2000);
+      cloud.points.push_back({static_cast<float>(r * std::cos(a)), static_cast<float>(r * std::sin(a)),
+                              static_cast<float>(-1.7 + 0.01 * (i % 7)), 0.3f});
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    for (int k = 0; k < 3; ++k) detector_->detect(cloud, &cloud, Eigen::Isometry3d::Identity());
+    NODELET_INFO_STREAM("detector warmed up in "
+                        << std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()
+                        << " s (3 synthetic scans of 120k points)");
   }
 
   void process(const sensor_msgs::PointCloud2::ConstPtr& msg) override {
