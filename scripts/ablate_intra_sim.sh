@@ -2,7 +2,8 @@
 # IntraRM on this package's detector, simulated data (Ret3D Tables 3, 5, 6 analogues):
 #   trains every config/relation/intra_lwd3d*.yaml on the default detector's boxes and features over the relation
 #   set (urban, seeds 3000-3011: sequences 0-9 train, 10-11 validation), then runs base + IntraRM on the held-out set
-#   (scripts/eval_heldout.sh: urban seeds 9000-9004, 500 frames) and prints one row per configuration.
+#   (scripts/eval_heldout.sh: urban seeds 9000-9004, 500 frames), prints one row per configuration and writes the
+#   table between the intra-sim-ablation markers of docs/RESULTS.md.
 #   scripts/ablate_intra_sim.sh [CONFIGS...]     (default: all; two trainings at a time, one thread each)
 # Work files: out/ablate_intra_sim/. Needs models/lwd3d/detector.pt.
 set -eo pipefail
@@ -46,8 +47,11 @@ done
 python3 - "${CONFIGS[@]}" <<'PY'
 import json, sys
 rows = ["base"] + sys.argv[1:]
-print("| configuration | Car 3D | Ped 3D | Cyc 3D | L2 mAP | L2 mAPH | train s |")
-print("| --- | --- | --- | --- | --- | --- | --- |")
+what = {"base": "base detector alone", "intra_lwd3d": "r 2 m, m 4 (shipped)", "intra_lwd3d_no_edge": "no edges (r 2 m, m 4)",
+        "intra_lwd3d_r1": "r 1 m, m 4", "intra_lwd3d_r4": "r 4 m, m 4", "intra_lwd3d_m1": "r 2 m, m 1",
+        "intra_lwd3d_m2": "r 2 m, m 2", "intra_lwd3d_m6": "r 2 m, m 6"}
+out = ["| configuration | graph | Car 3D @0.7 | Ped 3D @0.5 | Cyc 3D @0.5 | L2 mAP | L2 mAPH | train s |",
+       "| --- | --- | --- | --- | --- | --- | --- | --- |"]
 for r in rows:
     m = json.load(open("out/heldout/%s/eval/metrics.json" % r))
     secs = ""
@@ -55,7 +59,15 @@ for r in rows:
         for line in open("out/ablate_intra_sim/%s.train.log" % r):
             if "IntraRM trained:" in line:
                 secs = line.split(" in ")[1].split(" s")[0]
-    print("| %s | %.2f | %.2f | %.2f | %.2f | %.2f | %s |" % (r, m["kitti.Car.3d.R40.moderate"],
-          m["kitti.Pedestrian.3d.R40.moderate"], m["kitti.Cyclist.3d.R40.moderate"], m["waymo.mean.L2.AP"],
-          m["waymo.mean.L2.APH"], secs))
+    out.append("| %s | %s | %.2f | %.2f | %.2f | %.2f | %.2f | %s |" % (r, what.get(r, ""), m["kitti.Car.3d.R40.moderate"],
+               m["kitti.Pedestrian.3d.R40.moderate"], m["kitti.Cyclist.3d.R40.moderate"], m["waymo.mean.L2.AP"],
+               m["waymo.mean.L2.APH"], secs))
+print("\n".join(out))
+path = "docs/RESULTS.md"
+text = open(path).read()
+begin, end = "<!-- intra-sim-ablation:begin -->", "<!-- intra-sim-ablation:end -->"
+if begin in text and end in text:
+    a, b = text.index(begin) + len(begin), text.index(end)
+    open(path, "w").write(text[:a] + "\n" + "\n".join(out) + "\n" + text[b:])
+    print("written to " + path)
 PY
