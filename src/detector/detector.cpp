@@ -87,4 +87,12 @@ Detections Detector::detect(const PointCloud& current, const PointCloud* previou
   return det;
 }
 
+void Detector::setThresholds(double score_threshold, double nms_iou) {
+  if (!(score_threshold >= 0 && score_threshold <= 1) || !(nms_iou >= 0 && nms_iou <= 1))
+    throw std::invalid_argument("detector thresholds must lie in [0, 1]: score_threshold " +
+                                std::to_string(score_threshold) + ", nms_iou " + std::to_string(nms_iou));
+  options_.inference.score_threshold = score_threshold;
+  options_.inference.nms_iou = nms_iou;
+}
+
 }  // namespace ret3d

@@ -6,12 +6,17 @@
 // longer than ~max_sweep_gap (previous sweep dropped).
 #include <chrono>
 #include <cmath>
+#include <mutex>
+
+#include <boost/thread/recursive_mutex.hpp>
+#include <dynamic_reconfigure/server.h>
 #include <pluginlib/class_list_macros.hpp>
 #include <sensor_msgs/PointCloud2.h>
 
 #include <optional>
 
 #include "ret3d/DetectionArray.h"
+#include "ret3d/DetectorConfig.h"
 #include "ret3d/detector/detector.h"
 #include "ret3d/ros/conversions.h"
 #include "ret3d/ros/detection_array.h"
@@ -29,6 +34,7 @@ class DetectorNodelet : public StageNodelet<sensor_msgs::PointCloud2> {
     detector_ = constructStage(getPrivateNodeHandle(), "model_path", params_.detector.inference.model_path,
                                [&] { return std::make_unique<Detector>(params_.detector); });
     warmUp();
+    startReconfigure();
     poses_ = std::make_unique<PoseSource>(params_.pose, getNodeHandle());
     publisher_ = getNodeHandle().advertise<ret3d::DetectionArray>("detections", 1);
     start("points");
@@ -49,6 +55,22 @@ class DetectorNodelet : public StageNodelet<sensor_msgs::PointCloud2> {
     NODELET_INFO_STREAM("detector warmed up in "
                         << std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()
                         << " s (3 synthetic scans of 120k points)");
+  }
+
+  // dynamic_reconfigure (cfg/Detector.cfg): the score threshold and the NMS IoU change between clouds. The server
+  // starts from the values the nodelet was configured with, not from the .cfg defaults.
+  void startReconfigure() {
+    reconfigure_ = std::make_unique<dynamic_reconfigure::Server<ret3d::DetectorConfig>>(reconfigure_mutex_,
+                                                                                        getPrivateNodeHandle());
+    ret3d::DetectorConfig start;
+    start.score_threshold = params_.detector.inference.score_threshold;
+    start.nms_iou = params_.detector.inference.nms_iou;
+    reconfigure_->updateConfig(start);
+    reconfigure_->setCallback([this](ret3d::DetectorConfig& c, std::uint32_t) {
+      std::lock_guard<std::mutex> lock(detector_mutex_);
+      detector_->setThresholds(c.score_threshold, c.nms_iou);
+      NODELET_INFO_STREAM("detector thresholds: score_threshold " << c.score_threshold << ", nms_iou " << c.nms_iou);
+    });
   }
 
   void process(const sensor_msgs::PointCloud2::ConstPtr& msg) override {
@@ -100,7 +122,11 @@ class DetectorNodelet : public StageNodelet<sensor_msgs::PointCloud2> {
       }
     }
 
-    const Detections detections = detector_->detect(cloud, previous, prev_to_current);
+    Detections detections;
+    {
+      std::lock_guard<std::mutex> lock(detector_mutex_);  // thresholds may change from the reconfigure thread
+      detections = detector_->detect(cloud, previous, prev_to_current);
+    }
     publisher_.publish(toDetectionArrayMsg(detections, msg->header));
 
     if (!previous_) previous_.emplace();
@@ -124,6 +150,9 @@ class DetectorNodelet : public StageNodelet<sensor_msgs::PointCloud2> {
   std::unique_ptr<PoseSource> poses_;
   ros::Publisher publisher_;
   std::optional<Sweep> previous_;
+  std::mutex detector_mutex_;
+  boost::recursive_mutex reconfigure_mutex_;
+  std::unique_ptr<dynamic_reconfigure::Server<ret3d::DetectorConfig>> reconfigure_;
 };
 
 }  // namespace ret3d

@@ -5,6 +5,8 @@
 // empty, all NaN, a million points, stamps going backwards, a frame without tf. For every cloud a DetectionArray comes
 // out with the cloud's stamp and frame id, and the nodelet says what it worked around. A model that does not fit the
 // configuration, or a missing one, makes it refuse to start with a message naming the parameter.
+#include <dynamic_reconfigure/DoubleParameter.h>
+#include <dynamic_reconfigure/Reconfigure.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <sensor_msgs/PointCloud2.h>
@@ -240,6 +242,59 @@ TEST_F(DetectorNodeletTest, EveryCloudGivesDetectionsAndWhatWasDoneIsSaid) {
   EXPECT_FALSE(log_.find({"no transform", "lidar_without_tf", "without motion compensation"}).empty()) << log_.all();
   std::lock_guard<std::mutex> lock(mutex);
   EXPECT_EQ(out.size(), sent);
+}
+
+TEST_F(DetectorNodeletTest, ThresholdsChangeAtRunTimeThroughDynamicReconfigure) {
+  ros::NodeHandle nh;
+  ros::AsyncSpinner spinner(2);
+  spinner.start();
+  nodelet::Loader loader(false);
+  ASSERT_TRUE(test::loadNodelet(loader, "/ret3d_detector", "ret3d/DetectorNodelet")) << log_.all();
+  std::mutex mutex;
+  std::vector<ret3d::DetectionArray::ConstPtr> out;
+  ros::Subscriber sub = nh.subscribe<ret3d::DetectionArray>(
+      "/detections", 100, [&](const ret3d::DetectionArray::ConstPtr& m) {
+        std::lock_guard<std::mutex> lock(mutex);
+        out.push_back(m);
+      });
+  ros::Publisher points = nh.advertise<sensor_msgs::PointCloud2>("/points", 10);
+  ASSERT_TRUE(test::waitFor([&] { return points.getNumSubscribers() > 0 && sub.getNumPublishers() > 0; }, 10.0));
+  ASSERT_TRUE(ros::service::waitForService("/ret3d_detector/set_parameters", ros::Duration(10.0)));
+
+  // Sets the score threshold (NMS at IoU 1: nothing suppressed) and returns the boxes of the next cloud.
+  double t = 2.0e9;
+  auto objectsAt = [&](double score_threshold) -> std::size_t {
+    dynamic_reconfigure::Reconfigure srv;
+    dynamic_reconfigure::DoubleParameter p;
+    p.name = "score_threshold", p.value = score_threshold;
+    srv.request.config.doubles.push_back(p);
+    p.name = "nms_iou", p.value = 1.0;
+    srv.request.config.doubles.push_back(p);
+    EXPECT_TRUE(ros::service::call("/ret3d_detector/set_parameters", srv));
+    for (const auto& d : srv.response.config.doubles)
+      if (d.name == "score_threshold") EXPECT_DOUBLE_EQ(d.value, score_threshold);
+    std_msgs::Header h;
+    h.frame_id = "velodyne";
+    h.stamp = ros::Time(t += 0.1);
+    const std::size_t before = [&] {
+      std::lock_guard<std::mutex> lock(mutex);
+      return out.size();
+    }();
+    points.publish(boost::make_shared<sensor_msgs::PointCloud2>(toPointCloud2(seq_.scans[0], h)));
+    EXPECT_TRUE(test::waitFor(
+        [&] {
+          std::lock_guard<std::mutex> lock(mutex);
+          return out.size() > before;
+        },
+        30.0));
+    std::lock_guard<std::mutex> lock(mutex);
+    return out.back()->objects.size();
+  };
+  // The untrained network scores everything near its prior (~0.01): a zero threshold passes boxes, 1.0 none.
+  EXPECT_GT(objectsAt(0.0), 0u);
+  EXPECT_EQ(objectsAt(1.0), 0u);
+  EXPECT_GT(objectsAt(0.0), 0u);
+  EXPECT_FALSE(log_.find({"detector thresholds", "score_threshold 1"}).empty()) << log_.all();
 }
 
 TEST_F(DetectorNodeletTest, ModelThatDoesNotFitTheConfigIsRefused) {

@@ -43,6 +43,8 @@ class Detector {
                     const Eigen::Isometry3d& prev_to_current = Eigen::Isometry3d::Identity());
 
   const DetectorOptions& options() const { return options_; }
+  // Changes the inference thresholds between calls (dynamic_reconfigure); throws std::invalid_argument outside [0, 1].
+  void setThresholds(double score_threshold, double nms_iou);
   const DetectorTimings& lastTimings() const { return timings_; }
   int featureDim() const;
   std::int64_t parameterCount() const;
