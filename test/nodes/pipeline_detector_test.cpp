@@ -245,18 +245,18 @@ TEST_F(DetectorNodeletTest, EveryCloudGivesDetectionsAndWhatWasDoneIsSaid) {
 }
 
 TEST_F(DetectorNodeletTest, ThresholdsChangeAtRunTimeThroughDynamicReconfigure) {
-  ros::NodeHandle nh;
   ros::AsyncSpinner spinner(2);
   spinner.start();
   nodelet::Loader loader(false);
   ASSERT_TRUE(test::loadNodelet(loader, "/ret3d_detector", "ret3d/DetectorNodelet")) << log_.all();
-  std::mutex mutex;
+  ros::NodeHandle nh;
+  std::mutex mutex;  // guards `out`, filled by the subscriber below
   std::vector<ret3d::DetectionArray::ConstPtr> out;
-  ros::Subscriber sub = nh.subscribe<ret3d::DetectionArray>(
-      "/detections", 100, [&](const ret3d::DetectionArray::ConstPtr& m) {
-        std::lock_guard<std::mutex> lock(mutex);
-        out.push_back(m);
-      });
+  auto keep = [&](const ret3d::DetectionArray::ConstPtr& m) {
+    std::lock_guard<std::mutex> lock(mutex);
+    out.push_back(m);
+  };
+  ros::Subscriber sub = nh.subscribe<ret3d::DetectionArray>("/detections", 100, keep);
   ros::Publisher points = nh.advertise<sensor_msgs::PointCloud2>("/points", 10);
   ASSERT_TRUE(test::waitFor([&] { return points.getNumSubscribers() > 0 && sub.getNumPublishers() > 0; }, 10.0));
   ASSERT_TRUE(ros::service::waitForService("/ret3d_detector/set_parameters", ros::Duration(10.0)));
