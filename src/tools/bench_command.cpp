@@ -18,6 +18,7 @@
 
 #include "ret3d/core/log.h"
 #include "ret3d/io/kitti.h"
+#include "ret3d/io/sweeps.h"
 #include "ret3d/ros/conversions.h"
 #include "tools/command.h"
 #include "tools/offline_pipeline.h"
@@ -66,17 +67,9 @@ std::vector<BenchFrame> framesFromData(const BenchArgs& a) {
   const auto seqs = ds.sequences();
   if (seqs.empty()) throw std::runtime_error(a.data + ": no scans (a folder of .bin files or a KITTI layout expected)");
   const std::string seq = a.sequence.empty() ? seqs.front() : a.sequence;
-  const auto poses = ds.lidarPoses(seq);
-  int prev = -2;
-  for (const int f : ds.frames(seq)) {
-    if (static_cast<int>(out.size()) >= a.max_frames) break;
-    BenchFrame fr;
-    fr.cloud = kitti::readVelodyne(ds.velodynePath(seq, f));
-    if (f < static_cast<int>(poses.size())) fr.pose = poses[static_cast<std::size_t>(f)];
-    fr.follows = prev == f - 1;
-    prev = f;
-    out.push_back(std::move(fr));
-  }
+  io::forEachSweep(ds, seq, [&](const io::Sweep& s) {
+    if (static_cast<int>(out.size()) < a.max_frames) out.push_back({*s.cloud, s.pose, s.previous != nullptr});
+  });
   return out;
 }
 

@@ -105,23 +105,33 @@ bool isObjectLayout(const std::string& root) {
   return false;
 }
 
+// Every frame of a KITTI object folder: `detect` gives its boxes, written as a KITTI object result file.
+template <class DetectFrame>
+std::size_t detectObjectFrames(const DetectArgs& a, DetectFrame detect) {
+  kitti::ObjectDataset ds(a.data);
+  const auto frames = ds.frames();
+  ProgressBar bar("detect", frames.size());
+  std::size_t boxes = 0;
+  for (const std::string& fr : frames) {
+    const kitti::Calibration calib = kitti::readCalibration(ds.calibPath(fr));
+    const Detections d = detect(ds, fr, calib);
+    boxes += d.size();
+    kitti::writeObjectLabels(a.out + "/" + fr + ".txt", toLabels(d, calib, -1));
+    bar.tick();
+  }
+  return boxes;
+}
+
 // The base detector on a KITTI-layout folder's scans.
 std::size_t detectFromScans(const DetectArgs& a, OfflinePipeline* p) {
   std::size_t boxes = 0;
   if (isObjectLayout(a.data)) {
     if (p->tracks()) throw std::runtime_error("--stages track/inter need sequences: " + a.data + " has the object layout");
-    kitti::ObjectDataset ds(a.data);
-    const auto frames = ds.frames();
-    ProgressBar bar("detect", frames.size());
-    for (const std::string& fr : frames) {
-      const kitti::Calibration calib = kitti::readCalibration(ds.calibPath(fr));
+    return detectObjectFrames(a, [&](const kitti::ObjectDataset& ds, const std::string& fr, const kitti::Calibration&) {
       const PointCloud cloud = kitti::readVelodyne(ds.velodynePath(fr));
-      const Detections d = p->run(&cloud, nullptr, Eigen::Isometry3d::Identity(), {}, 0.0, Eigen::Isometry3d::Identity());
-      boxes += d.size();
-      kitti::writeObjectLabels(a.out + "/" + fr + ".txt", toLabels(d, calib, -1));
-      bar.tick();
-    }
-    return boxes;
+      const Eigen::Isometry3d I = Eigen::Isometry3d::Identity();
+      return p->run(&cloud, nullptr, I, {}, 0.0, I);
+    });
   }
   kitti::TrackingDataset ds(a.data);
   const std::vector<std::string> seqs = a.sequences.empty() ? ds.sequences() : eval::parseSequenceList(a.sequences);
@@ -163,17 +173,9 @@ std::size_t detectFromResults(const DetectArgs& a, OfflinePipeline* p) {
   if (layout == io::DetectionLayout::KittiObject) {
     if (p->tracks())
       throw std::runtime_error("--stages track/inter need sequences: " + a.detections + " holds per-frame object results");
-    kitti::ObjectDataset ds(a.data);
-    const auto frames = ds.frames();
-    ProgressBar bar("detect", frames.size());
-    for (const std::string& fr : frames) {
-      const kitti::Calibration calib = kitti::readCalibration(ds.calibPath(fr));
-      const Detections d = p->run(nullptr, nullptr, I, toDetections(io::readFrameDetections(a.detections, fr), calib), 0, I);
-      boxes += d.size();
-      kitti::writeObjectLabels(a.out + "/" + fr + ".txt", toLabels(d, calib, -1));
-      bar.tick();
-    }
-    return boxes;
+    return detectObjectFrames(a, [&](const kitti::ObjectDataset&, const std::string& fr, const kitti::Calibration& calib) {
+      return p->run(nullptr, nullptr, I, toDetections(io::readFrameDetections(a.detections, fr), calib), 0, I);
+    });
   }
   kitti::TrackingDataset ds(a.data);
   const std::vector<std::string> seqs = a.sequences.empty() ? ds.sequences() : eval::parseSequenceList(a.sequences);

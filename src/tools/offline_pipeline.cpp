@@ -20,12 +20,15 @@ double msSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// The explicit file, else <models>/<name> when it exists, else "".
-std::string resolveModel(const std::string& explicit_path, const std::string& models, const std::string& name) {
+// The explicit file, else <models>/<name> when it exists; throws naming both ways to give it when neither does.
+std::string resolveModel(const std::string& explicit_path, const std::string& models, const std::string& name,
+                         const std::string& stage, const std::string& what, const std::string& option) {
   if (!explicit_path.empty()) return explicit_path;
-  if (models.empty()) return "";
-  const std::string p = (fs::path(models) / name).string();
-  return fs::exists(p) ? p : "";
+  const std::string p = models.empty() ? "" : (fs::path(models) / name).string();
+  if (p.empty() || !fs::exists(p))
+    throw std::runtime_error("--stages " + stage + " needs " + what + ": --models DIR with " + name + ", or " + option +
+                             " FILE");
+  return p;
 }
 
 bool has(const std::vector<std::string>& v, const std::string& s) { return std::find(v.begin(), v.end(), s) != v.end(); }
@@ -57,8 +60,8 @@ OfflinePipeline::OfflinePipeline(const PipelineConfig& c) : stages_(c.stages) {
   for (const std::string& s : stages_) desc << " " << s;
   if (stages_.empty()) desc << " none";
   if (has(stages_, "base")) {
-    const std::string path = resolveModel(c.detector_model, c.models, "detector.pt");
-    if (path.empty()) throw std::runtime_error("--stages base needs a detector model: --models DIR with detector.pt, or --detector-model FILE");
+    const std::string path =
+        resolveModel(c.detector_model, c.models, "detector.pt", "base", "a detector model", "--detector-model");
     DetectorOptions o = detectorOptionsForModel(path, c.detector_config);
     o.inference.threads = c.threads;
     if (c.score_threshold >= 0) o.inference.score_threshold = c.score_threshold;
@@ -68,16 +71,14 @@ OfflinePipeline::OfflinePipeline(const PipelineConfig& c) : stages_(c.stages) {
   }
   if (has(stages_, "intra")) {
     relation::IntraRMOptions o;
-    o.model_path = resolveModel(c.intra_model, c.models, "intra_rm.pt");
-    if (o.model_path.empty()) throw std::runtime_error("--stages intra needs an IntraRM model: --models DIR with intra_rm.pt, or --intra-model FILE");
+    o.model_path = resolveModel(c.intra_model, c.models, "intra_rm.pt", "intra", "an IntraRM model", "--intra-model");
     o.threads = c.threads;
     intra_ = std::make_unique<relation::IntraRM>(o);
     desc << "; IntraRM " << o.model_path;
   }
   if (has(stages_, "inter")) {
     relation::InterRMOptions o;
-    o.model_path = resolveModel(c.inter_model, c.models, "inter_rm.pt");
-    if (o.model_path.empty()) throw std::runtime_error("--stages inter needs an InterRM model: --models DIR with inter_rm.pt, or --inter-model FILE");
+    o.model_path = resolveModel(c.inter_model, c.models, "inter_rm.pt", "inter", "an InterRM model", "--inter-model");
     o.threads = c.threads;
     inter_ = std::make_unique<relation::InterRM>(o);
     desc << "; InterRM " << o.model_path;
