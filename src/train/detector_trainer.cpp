@@ -76,6 +76,12 @@ DetectorTrainResult trainDetector(const DetectorTrainJob& job) {
     ck.step = st["step"].as<int>();
     RET3D_INFO("resuming from " << base << ".ckpt at epoch " << ck.epoch + 1 << ", batch " << ck.batch << ", step "
                                 << ck.step);
+  } else if (!job.init_model.empty()) {
+    if (job.resume)
+      RET3D_INFO("--resume: no checkpoint at " << base << ".ckpt.state yet; starting from " << job.init_model);
+    // The config's model part must match the file's (load() refuses otherwise), so the anchors come from the file.
+    model = nn::DetectorModel::load(job.init_model, &o.model);
+    RET3D_INFO("starting from the weights of " << job.init_model << " (fresh optimiser and schedule)");
   } else {
     if (job.resume) RET3D_WARN("--resume: no checkpoint at " << base << ".ckpt.state; starting afresh");
     std::vector<Anchor> anchors;

@@ -17,6 +17,8 @@ struct DetectorTrainJob {
   DetectorOptions options;
   std::string config_text;    // the YAML the options came from, stored in the model file
   bool resume = false;
+  std::string init_model;     // when set (and not resuming): start from this model's weights and anchors, with a
+                              // fresh optimiser and learning-rate schedule (a second, fine-tuning stage)
   bool progress = true;       // draw the progress bar
 };
 
