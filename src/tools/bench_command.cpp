@@ -1,7 +1,11 @@
-// `ret3d bench --data DIR|--bag FILE --models DIR [--stages LIST] [--json FILE]`: times each stage of the pipeline
-// over real frames, after a warm-up, and prints the median and p95 per stage (the base detector split into BEV,
-// network, decoding and NMS). Scans come from a KITTI tracking or object folder, a folder of .bin scans, or the
-// PointCloud2 messages of a bag. Frames are cycled until --min-runs timed runs, so a short drive still gives a p95.
+// `ret3d bench --data DIR|--bag FILE --models DIR [--stages LIST] [--json FILE]`: times the pipeline.
+// --bag FILE: through the real nodelets in one manager (tools/nodelet_bench.h): the bag played at its rate from a
+// player process, per-stage times and end-to-end latency (cloud stamp to /objects) p50 / p95, drops, CPU use.
+// --data DIR (or --bag FILE --in-process): each stage called in this process over real frames, after a warm-up; the
+// median and p95 per stage (the base detector split into BEV, network, decoding and NMS). Scans come from a KITTI
+// tracking or object folder, a folder of .bin scans, or the PointCloud2 messages of a bag. Frames are cycled until
+// --min-runs timed runs, so a short drive still gives a p95.
+// Neither: the stages after the detector timed on synthetic frames of --objects objects.
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -20,7 +24,9 @@
 #include "ret3d/io/kitti.h"
 #include "ret3d/io/sweeps.h"
 #include "ret3d/ros/conversions.h"
+#include "ret3d/ros/params.h"
 #include "tools/command.h"
+#include "tools/nodelet_bench.h"
 #include "tools/offline_pipeline.h"
 
 namespace ret3d {
@@ -33,6 +39,9 @@ struct BenchArgs {
   PipelineConfig pipeline;
   std::string data, bag, topic, stages = "base,intra,track,inter", json, sequence, objects = "50,300";
   int warmup = 5, min_runs = 100, max_frames = 200, history_frames = 40;
+  bool in_process = false;  // --bag: time the stages in this process instead of through the nodelets
+  bool no_markers = false;
+  NodeletBenchOptions nodelets;  // --bag through the nodelets: the options only that run has
 };
 
 // One input frame: the scan and the ego motion from the previous one (identity when unknown).
@@ -54,7 +63,7 @@ std::vector<BenchFrame> framesFromData(const BenchArgs& a) {
   };
   // A folder of scans (e.g. ../shared/data/unlabeled_scans), or the object layout: consecutive files are not
   // necessarily consecutive sweeps, but the 22 unlabeled scans are; the motion between them is unknown (identity).
-  for (const fs::path dir : {fs::path(a.data), fs::path(a.data) / "velodyne", fs::path(a.data) / "training" / "velodyne"}) {
+  for (const fs::path& dir : {fs::path(a.data), fs::path(a.data) / "velodyne", fs::path(a.data) / "training" / "velodyne"}) {
     const auto bins = binsIn(dir);
     if (bins.empty()) continue;
     for (const std::string& b : bins) {
@@ -200,8 +209,42 @@ int benchSynthetic(const BenchArgs& a) {
   return 0;
 }
 
+// The model file a stage runs with: the explicit file, else <--models>/<name>, else the package's default (as
+// launch/ret3d.launch); checked here so that a wrong path stops the bench before any process starts.
+std::string nodeletModel(const std::string& explicit_path, const std::string& models, const std::string& name,
+                         const std::string& option) {
+  const std::string path = !explicit_path.empty() ? explicit_path
+                           : models.empty()       ? defaultModelPath(name)
+                                                  : (fs::path(models) / name).string();
+  if (!fs::is_regular_file(path))
+    throw std::runtime_error(path + ": no such model file (give --models DIR with " + name + ", or " + option + ")");
+  return path;
+}
+
+int benchNodelets(const BenchArgs& a) {
+  NodeletBenchOptions o = a.nodelets;
+  const PipelineConfig& p = a.pipeline;
+  auto has = [&](const char* s) { return std::find(p.stages.begin(), p.stages.end(), s) != p.stages.end(); };
+  o.bag = a.bag;
+  o.topic = a.topic;
+  o.stages = p.stages;
+  o.detector_model = nodeletModel(p.detector_model, p.models, "detector.pt", "--detector-model FILE");
+  if (has("intra")) o.intra_model = nodeletModel(p.intra_model, p.models, "intra_rm.pt", "--intra-model FILE");
+  if (has("inter")) o.inter_model = nodeletModel(p.inter_model, p.models, "inter_rm.pt", "--inter-model FILE");
+  o.detector_config = p.detector_config;
+  o.tracker_config = p.tracker_config;
+  o.score_threshold = p.score_threshold;
+  o.threads = p.threads;
+  o.warmup = a.warmup;
+  o.max_frames = a.max_frames;
+  o.json = a.json;
+  o.markers = !a.no_markers;
+  return runNodeletBench(o);
+}
+
 int runBench(BenchArgs a) {
   a.pipeline.stages = parseStages(a.stages);
+  if (!a.bag.empty() && a.data.empty() && !a.in_process) return benchNodelets(a);
   if (!a.pipeline.stages.empty() && a.pipeline.stages.front() != "base" && a.data.empty() && a.bag.empty())
     return benchSynthetic(a);
   if (a.data.empty() == a.bag.empty()) throw std::runtime_error("give exactly one of --data DIR and --bag FILE");
@@ -259,27 +302,40 @@ int runBench(BenchArgs a) {
   return 0;
 }
 
-CommandRegistrar reg("bench", "time each pipeline stage over real scans (median and p95)", [](CLI::App& app) -> CommandRun {
+CommandRegistrar reg("bench", "time the pipeline: through the nodelets on a bag, or each stage in-process (median and p95)",
+                     [](CLI::App& app) -> CommandRun {
   auto a = std::make_shared<BenchArgs>();
   PipelineConfig& p = a->pipeline;
   app.add_option("--data", a->data, "scans: a folder of .bin files, a KITTI object or tracking folder");
   app.add_option("--sequence", a->sequence, "tracking layout: the sequence to time (default: the first)");
-  app.add_option("--bag", a->bag, "scans: the PointCloud2 messages of a bag");
+  app.add_option("--bag", a->bag, "a bag played through the real nodelets in one manager (with --in-process: its "
+                                  "clouds timed stage by stage in this process)");
+  app.add_flag("--in-process", a->in_process, "--bag: time each stage in this process, as with --data");
+  NodeletBenchOptions& n = a->nodelets;
+  app.add_option("--rate", n.rate, "--bag: playback speed factor (as rosbag play -r)")->capture_default_str();
+  app.add_option("--params", n.params, "--bag: the nodelets' YAML (default: $(find ret3d)/config/ret3d.yaml)");
+  app.add_option("--manager-threads", n.manager_threads, "--bag: the manager's callback threads")
+      ->capture_default_str();
+  app.add_option("--tail", n.tail, "--bag: s to wait after the last cloud for its outputs")->capture_default_str();
+  app.add_flag("--no-markers", a->no_markers, "--bag: without the MarkerNodelet (the launch file loads it)");
   app.add_option("--topic", a->topic, "bag topic (default: the first PointCloud2 topic)");
   app.add_option("--models", p.models, "folder with detector.pt, intra_rm.pt, inter_rm.pt (e.g. models/lwd3d)");
   app.add_option("--detector-model", p.detector_model, "detector model file (overrides --models)");
   app.add_option("--intra-model", p.intra_model, "IntraRM model file (overrides --models)");
   app.add_option("--inter-model", p.inter_model, "InterRM model file (overrides --models)");
-  app.add_option("--tracker-config", p.tracker_config, "tracker YAML (default: built-in values)");
+  app.add_option("--detector-config", p.detector_config, "detector YAML (default: the config in the model file)");
+  app.add_option("--tracker-config", p.tracker_config,
+                 "tracker YAML (default: built-in values; --bag: the one config/ret3d.yaml names)");
   app.add_option("--score-threshold", p.score_threshold, "detector score threshold (default: the model's)");
   app.add_option("--stages", a->stages, "comma-separated stages in order, starting with base")->capture_default_str();
   app.add_option("--threads", p.threads, "CPU threads for libtorch")->capture_default_str();
-  app.add_option("--warmup", a->warmup, "untimed runs first")->capture_default_str();
+  app.add_option("--warmup", a->warmup, "untimed runs first (--bag: clouds left out of the statistics)")->capture_default_str();
   app.add_option("--min-runs", a->min_runs, "timed runs (frames are cycled)")->capture_default_str();
   app.add_option("--max-frames", a->max_frames, "frames read at most")->capture_default_str();
   app.add_option("--objects", a->objects, "without the base stage: object counts of the synthetic frames")
       ->capture_default_str();
-  app.add_option("--json", a->json, "write {\"<stage>\": {\"median_ms\", \"p95_ms\"}, ..., \"total\": {...}}");
+  app.add_option("--json", a->json, "write {\"<stage>\": {\"median_ms\", \"p95_ms\"}, ..., \"total\": {...}} (--bag: "
+                                    "..., \"end_to_end\": {...}, \"frames\", \"dropped\", \"cpu_cores\")");
   return [a]() { return runBench(*a); };
 });
 

@@ -1,0 +1,41 @@
+// `ret3d bench --bag FILE` (the default with a bag): the pipeline timed as it runs online. This process becomes the
+// nodelet manager: it loads the real stage nodelets (ret3d/DetectorNodelet, IntraRMNodelet, TrackerNodelet,
+// InterRMNodelet, MarkerNodelet) with the parameters and topics of launch/ret3d.launch, while a player process (forked
+// from this one, so the clouds cross a process boundary as they do from a driver or `rosbag play`) publishes the bag's
+// clouds at the bag's rate, restamped by one constant offset to the wall clock, with the bag's /tf restamped alike and
+// /tf_static as it is. The manager records when each stage's output arrives for each cloud stamp: per-stage times,
+// end-to-end latency (cloud stamp to /objects), frames without output, and the CPU the manager process used.
+// A private ROS master (rosmaster --core on a free port) keeps the run apart from any ROS system on the machine.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace ret3d {
+namespace tools {
+
+struct NodeletBenchOptions {
+  std::string bag;
+  std::string topic;                // the bag's PointCloud2 topic (default: the first)
+  std::vector<std::string> stages;  // parseStages(): base first; "inter" implies the tracker
+  std::string detector_model, intra_model, inter_model;  // resolved files (existence checked by the caller)
+  std::string detector_config;      // empty: the config stored in the detector's model file
+  std::string tracker_config;       // empty: the one config/ret3d.yaml names
+  std::string params;               // the nodelets' YAML (default: $(find ret3d)/config/ret3d.yaml)
+  double score_threshold = -1;      // >= 0: overrides ret3d_detector/score_threshold
+  int threads = 2;                  // libtorch threads of each learned stage (the launch file's `threads`)
+  int manager_threads = 4;          // the manager's callback threads (the launch file's `manager_threads`)
+  bool markers = true;              // load the MarkerNodelet too, as the launch file does (only with InterRM)
+  double rate = 1.0;                // playback speed factor (rosbag play -r)
+  int warmup = 5;                   // first clouds left out of the statistics
+  int max_frames = 200;             // clouds played at most
+  double tail = 3.0;                // s to wait after the last cloud for its outputs
+  std::string json;                 // results file (empty: none)
+};
+
+// Runs the bench; prints the table; returns the exit code. Throws std::runtime_error naming what is wrong (the bag,
+// a nodelet that did not start, no ROS master).
+int runNodeletBench(const NodeletBenchOptions& options);
+
+}  // namespace tools
+}  // namespace ret3d
