@@ -13,7 +13,11 @@ source scripts/env.sh
 set -u
 OUT=out/ablate_intra_sim
 DET=${DETECTOR:-models/lwd3d/detector.pt}
+# Results of another detector are stale: start afresh when it changed.
+stamp=$(md5sum "$DET" | cut -c1-32)
+if [ "$(cat "$OUT/detector.md5" 2>/dev/null)" != "$stamp" ]; then rm -rf "$OUT" out/heldout/base out/heldout/intra_lwd3d*; fi
 mkdir -p "$OUT"
+echo "$stamp" >"$OUT/detector.md5"
 CONFIGS=("$@")
 if [ ${#CONFIGS[@]} -eq 0 ]; then
   CONFIGS=(intra_lwd3d intra_lwd3d_no_edge intra_lwd3d_r1 intra_lwd3d_r4 intra_lwd3d_m1 intra_lwd3d_m2 intra_lwd3d_m6)
@@ -31,43 +35,12 @@ train() {  # config
     --config "config/relation/$1.yaml" --sequences 0-9 --val-sequences 10-11 --out "$OUT/$1.pt" --threads 1 --quiet \
     >"$OUT/$1.train.log" 2>&1
 }
-# The detector's outputs once (the cache), then the trainings two at a time.
-train "${CONFIGS[0]}"
-for ((i = 1; i < ${#CONFIGS[@]}; i += 2)); do
-  train "${CONFIGS[$i]}" &
-  if ((i + 1 < ${#CONFIGS[@]})); then train "${CONFIGS[$((i + 1))]}"; fi
-  wait
-done
+source scripts/two_at_a_time.sh
+two_at_a_time train "${CONFIGS[@]}"
 
 [ -f out/heldout/base/eval/metrics.json ] || scripts/eval_heldout.sh base base --detector-model "$DET" >/dev/null
 for c in "${CONFIGS[@]}"; do
   [ -f "out/heldout/$c/eval/metrics.json" ] ||
     scripts/eval_heldout.sh base,intra "$c" --detector-model "$DET" --intra-model "$OUT/$c.pt" >/dev/null
 done
-python3 - "${CONFIGS[@]}" <<'PY'
-import json, sys
-rows = ["base"] + sys.argv[1:]
-what = {"base": "base detector alone", "intra_lwd3d": "r 2 m, m 4 (shipped)", "intra_lwd3d_no_edge": "no edges (r 2 m, m 4)",
-        "intra_lwd3d_r1": "r 1 m, m 4", "intra_lwd3d_r4": "r 4 m, m 4", "intra_lwd3d_m1": "r 2 m, m 1",
-        "intra_lwd3d_m2": "r 2 m, m 2", "intra_lwd3d_m6": "r 2 m, m 6"}
-out = ["| configuration | graph | Car 3D @0.7 | Ped 3D @0.5 | Cyc 3D @0.5 | L2 mAP | L2 mAPH | train s |",
-       "| --- | --- | --- | --- | --- | --- | --- | --- |"]
-for r in rows:
-    m = json.load(open("out/heldout/%s/eval/metrics.json" % r))
-    secs = ""
-    if r != "base":
-        for line in open("out/ablate_intra_sim/%s.train.log" % r):
-            if "IntraRM trained:" in line:
-                secs = line.split(" in ")[1].split(" s")[0]
-    out.append("| %s | %s | %.2f | %.2f | %.2f | %.2f | %.2f | %s |" % (r, what.get(r, ""), m["kitti.Car.3d.R40.moderate"],
-               m["kitti.Pedestrian.3d.R40.moderate"], m["kitti.Cyclist.3d.R40.moderate"], m["waymo.mean.L2.AP"],
-               m["waymo.mean.L2.APH"], secs))
-print("\n".join(out))
-path = "docs/RESULTS.md"
-text = open(path).read()
-begin, end = "<!-- intra-sim-ablation:begin -->", "<!-- intra-sim-ablation:end -->"
-if begin in text and end in text:
-    a, b = text.index(begin) + len(begin), text.index(end)
-    open(path, "w").write(text[:a] + "\n" + "\n".join(out) + "\n" + text[b:])
-    print("written to " + path)
-PY
+python3 scripts/results_table.py intra "$OUT" "${CONFIGS[@]}"

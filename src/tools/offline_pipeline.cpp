@@ -84,7 +84,10 @@ OfflinePipeline::OfflinePipeline(const PipelineConfig& c) : stages_(c.stages) {
     desc << "; InterRM " << o.model_path;
   }
   if (has(stages_, "track") || has(stages_, "inter")) {
-    const TrackerOptions t = c.tracker_config.empty() ? TrackerOptions{} : loadTrackerOptions(c.tracker_config);
+    TrackerOptions t = c.tracker_config.empty() ? TrackerOptions{} : loadTrackerOptions(c.tracker_config);
+    // As in the ROS pipeline (the InterRM nodelet keeps max_history boxes per track), the history InterRM sees is
+    // its model's max_history, whatever the tracker config says.
+    if (inter_) t.history_length = inter_->arch().max_history;
     tracking_ = std::make_unique<train::TrackingRefiner>(t, inter_.get());
     desc << "; tracker " << (c.tracker_config.empty() ? "built-in defaults" : c.tracker_config);
   }

@@ -52,9 +52,12 @@ int runTrainInter(const TrainInterArgs& a) {
   data.detections_dir = a.detections;
   data.intra_model = a.intra_model;
   if (!a.tracker_config.empty()) data.tracker = loadTrackerOptions(a.tracker_config);
-  if (data.tracker.history_length < opt.config.model.max_history)
-    RET3D_WARN("the tracker keeps " << data.tracker.history_length << " boxes per track, InterRM could use "
-                                    << opt.config.model.max_history);
+  // The tracker keeps as many boxes per track as InterRM reads (the InterRM nodelet keeps max_history too).
+  if (data.tracker.history_length != opt.config.model.max_history) {
+    RET3D_INFO("tracker history_length " << data.tracker.history_length << " -> " << opt.config.model.max_history
+                                         << " (the InterRM config's max_history)");
+    data.tracker.history_length = opt.config.model.max_history;
+  }
   auto load = [&](const std::string& list, const std::string& suffix) {
     data.sequences = list.empty() ? std::vector<std::string>{} : eval::parseSequenceList(list);
     io::SequenceDetections own;  // this package's detector's boxes and features, when --detector is given

@@ -1,0 +1,66 @@
+#!/usr/bin/env bash
+# InterRM on this package's detector and IntraRM, simulated data (Ret3D Table 4 analogue and the history length N):
+#   trains InterRM for every history length N (config/relation/inter_lwd3d.yaml with max_history N) and every
+#   positional encoding (config/relation/inter_lwd3d_pe_*.yaml, N = the shipped one) on the default models' boxes
+#   over the relation set (urban, seeds 3000-3011: sequences 0-9 train, 10-11 validation), then runs
+#   base + IntraRM + tracker (every detection tracked) + InterRM on the held-out set (scripts/eval_heldout.sh: urban
+#   seeds 9000-9004, 500 frames) and times tracker + InterRM for 50 tracks with full histories (`ret3d bench`).
+#   Prints one row per configuration and writes the tables between the inter-sim-history and inter-sim-pe markers
+#   of docs/RESULTS.md.
+#   scripts/ablate_inter_sim.sh            (two trainings at a time, one thread each; ~1 min per training)
+#   HISTORIES="1 10 30" scripts/ablate_inter_sim.sh
+# Work files: out/ablate_inter_sim/. Needs models/lwd3d/{detector,intra_rm}.pt.
+set -eo pipefail
+cd "$(dirname "$0")/.."
+set +u
+source scripts/env.sh
+set -u
+OUT=${OUT:-out/ablate_inter_sim}
+MODELS=${MODELS:-models/lwd3d}
+HISTORIES=${HISTORIES-1 5 10 30 60 100}
+PES=${PES-temporal spatial}
+TRACKER=config/tracker_lwd3d.yaml          # InterRM trains on confidently tracked objects
+TRACKER_EVAL=config/tracker_lwd3d_all.yaml # and runs behind the pipeline's tracker: every detection tracked
+# Results of other models are stale: start afresh when the detector or IntraRM changed.
+stamp=$(md5sum "$MODELS/detector.pt" "$MODELS/intra_rm.pt" | cut -c1-32 | tr -d '\n')
+if [ "$(cat "$OUT/models.md5" 2>/dev/null)" != "$stamp" ]; then rm -rf "$OUT" out/heldout/sim_inter_* out/heldout/sim_intra_track; fi
+mkdir -p "$OUT/configs"
+echo "$stamp" >"$OUT/models.md5"
+DATA=data/sim_relation_urban
+if [ ! -f "$DATA/.done" ]; then
+  rm -rf "$DATA"
+  ret3d sim --config config/sim/urban_street.yaml --out "$DATA" --sequences 12 --frames 80 --seed 3000
+  touch "$DATA/.done"
+fi
+
+NAMES=()
+for n in $HISTORIES; do
+  sed "s/^\(  max_history:\) *[0-9]*/\1 $n/" config/relation/inter_lwd3d.yaml >"$OUT/configs/inter_h$n.yaml"
+  NAMES+=("inter_h$n")
+done
+for pe in $PES; do
+  cp "config/relation/inter_lwd3d_pe_$pe.yaml" "$OUT/configs/inter_pe_$pe.yaml"
+  NAMES+=("inter_pe_$pe")
+done
+
+train() {  # name
+  [ -f "$OUT/$1.pt" ] && return
+  ret3d train inter --data "$DATA" --detector "$MODELS/detector.pt" --detections-cache "$OUT/dets.cache" \
+    --intra-model "$MODELS/intra_rm.pt" --tracker-config "$TRACKER" --config "$OUT/configs/$1.yaml" \
+    --sequences 0-9 --val-sequences 10-11 --out "$OUT/$1.pt" --threads 1 --quiet >"$OUT/$1.train.log" 2>&1
+}
+source scripts/two_at_a_time.sh
+two_at_a_time train "${NAMES[@]}"
+
+MODEL_FLAGS=(--detector-model "$MODELS/detector.pt" --intra-model "$MODELS/intra_rm.pt")
+[ -f out/heldout/sim_intra_track/eval/metrics.json ] ||
+  scripts/eval_heldout.sh base,intra,track sim_intra_track "${MODEL_FLAGS[@]}" --tracker-config "$TRACKER_EVAL" >/dev/null
+for c in "${NAMES[@]}"; do
+  [ -f "out/heldout/sim_$c/eval/metrics.json" ] ||
+    scripts/eval_heldout.sh base,intra,track,inter "sim_$c" "${MODEL_FLAGS[@]}" --inter-model "$OUT/$c.pt" \
+      --tracker-config "$TRACKER_EVAL" >/dev/null
+  [ -f "$OUT/$c.bench.json" ] ||
+    ret3d bench --stages track,inter --models "$MODELS" --inter-model "$OUT/$c.pt" --tracker-config "$TRACKER_EVAL" \
+      --objects 50 --json "$OUT/$c.bench.json" >"$OUT/$c.bench.log" 2>&1
+done
+python3 scripts/results_table.py inter "$OUT" "${NAMES[@]}"

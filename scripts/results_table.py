@@ -1,0 +1,101 @@
+#!/usr/bin/env python3
+"""Markdown tables of the simulated ablations (scripts/ablate_{intra,inter}_sim.sh) from their held-out evaluations
+(out/heldout/NAME/eval/metrics.json), printed and written into docs/RESULTS.md between the table's markers.
+
+  results_table.py intra OUT_DIR CONFIG...   # rows: base, then base + each IntraRM
+  results_table.py inter OUT_DIR NAME...     # rows: + IntraRM + tracker, then + each InterRM (history, encoding)
+"""
+import json
+import os
+import re
+import sys
+
+CLASSES = ("Car", "Pedestrian", "Cyclist")
+RESULTS = "docs/RESULTS.md"
+
+
+def metrics(name):
+    return json.load(open("out/heldout/%s/eval/metrics.json" % name))
+
+
+def ap_cells(m):
+    return ["%.2f" % m["kitti.%s.3d.R40.moderate" % c] for c in CLASSES] + [
+        "%.2f" % m["waymo.mean.L2.AP"], "%.2f" % m["waymo.mean.L2.APH"]]
+
+
+def train_seconds(log, marker):
+    """Wall time of a training from its log line '<marker> N epochs in S s; ...' ('' when absent)."""
+    if not os.path.exists(log):
+        return ""
+    for line in open(log):
+        if marker in line:
+            return "%.0f" % float(line.split(" in ")[1].split(" s")[0])
+    return ""
+
+
+def write_between(key, lines):
+    text = open(RESULTS).read()
+    begin, end = "<!-- %s:begin -->" % key, "<!-- %s:end -->" % key
+    if begin not in text or end not in text:
+        print("(no %s markers in %s: table not written)" % (key, RESULTS))
+        return
+    a, b = text.index(begin) + len(begin), text.index(end)
+    open(RESULTS, "w").write(text[:a] + "\n" + "\n".join(lines) + "\n" + text[b:])
+    print("written to %s (%s)" % (RESULTS, key))
+
+
+def intra_table(out, configs):
+    what = {"base": "base detector alone", "intra_lwd3d": "r 2 m, m 4 (shipped)",
+            "intra_lwd3d_no_edge": "no edges (r 2 m, m 4)", "intra_lwd3d_r1": "r 1 m, m 4",
+            "intra_lwd3d_r4": "r 4 m, m 4", "intra_lwd3d_m1": "r 2 m, m 1", "intra_lwd3d_m2": "r 2 m, m 2",
+            "intra_lwd3d_m6": "r 2 m, m 6"}
+    lines = ["| configuration | graph | Car 3D @0.7 | Ped 3D @0.5 | Cyc 3D @0.5 | L2 mAP | L2 mAPH | train s |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+    for r in ["base"] + configs:
+        secs = "" if r == "base" else train_seconds("%s/%s.train.log" % (out, r), "IntraRM trained:")
+        lines.append("| " + " | ".join([r, what.get(r, "")] + ap_cells(metrics(r)) + [secs]) + " |")
+    print("\n".join(lines))
+    write_between("intra-sim-ablation", lines)
+
+
+def inter_row(out, name, label):
+    m = metrics("sim_" + name)
+    cost = ""
+    bench = "%s/%s.bench.json" % (out, name)
+    if os.path.exists(bench):
+        b = json.load(open(bench))
+        if "total_50_spread" in b:
+            cost = "%.2f / %.2f" % (b["total_50_spread"]["median_ms"], b["total_50_spread"]["p95_ms"])
+    return ("| " + " | ".join([label] + ap_cells(m) + ["%.1f" % m["mot.Car.MOTA"], "%.1f" % m["mot.Car.HOTA"], cost,
+                                                        train_seconds("%s/%s.train.log" % (out, name),
+                                                                      "InterRM trained:")]) + " |")
+
+
+def inter_tables(out, names):
+    head = ["| %s | Car 3D @0.7 | Ped 3D @0.5 | Cyc 3D @0.5 | L2 mAP | L2 mAPH | Car MOTA | Car HOTA | "
+            "tracker + InterRM ms, 50 tracks (median / p95) | train s |",
+            "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+    base = "| " + " | ".join(["+ IntraRM + tracker, no InterRM"] + ap_cells(metrics("sim_intra_track")) + [
+        "%.1f" % metrics("sim_intra_track")["mot.Car.MOTA"], "%.1f" % metrics("sim_intra_track")["mot.Car.HOTA"], "",
+        ""]) + " |"
+    hist = sorted((int(re.match(r"inter_h(\d+)$", n).group(1)), n) for n in names if re.match(r"inter_h\d+$", n))
+    lines = [head[0] % "history N (implicit encoding)", head[1], base]
+    lines += [inter_row(out, n, "N = %d" % h) for h, n in hist]
+    print("\n".join(lines))
+    write_between("inter-sim-history", lines)
+    pes = [n for n in names if n.startswith("inter_pe_")]
+    if pes:
+        lines = [head[0] % "positional encoding", head[1], base]
+        shipped = [n for h, n in hist if h == 30]
+        if shipped:
+            lines.append(inter_row(out, shipped[0], "implicit (time offset as an input feature)"))
+        label = {"temporal": "temporal (sinusoids of the time offset)", "spatial": "spatial (sinusoids of the position)"}
+        lines += [inter_row(out, n, label.get(n[len("inter_pe_"):], n)) for n in pes]
+        print("\n".join(lines))
+        write_between("inter-sim-pe", lines)
+
+
+if __name__ == "__main__":
+    if len(sys.argv) < 3 or sys.argv[1] not in ("intra", "inter"):
+        sys.exit(__doc__)
+    (intra_table if sys.argv[1] == "intra" else inter_tables)(sys.argv[2], sys.argv[3:])
