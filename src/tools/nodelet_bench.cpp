@@ -4,7 +4,7 @@
 #include <fcntl.h>
 #include <netinet/in.h>
 #include <signal.h>
-#include <spawn.h>
+#include <sys/prctl.h>
 #include <sys/resource.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
@@ -37,8 +37,6 @@
 #include "ret3d/Object3DArray.h"
 #include "ret3d/ros/diagnostics.h"
 #include "ret3d/ros/params.h"
-
-extern char** environ;
 
 namespace ret3d {
 namespace tools {
@@ -172,27 +170,33 @@ int freePort() {
   return ntohs(addr.sin_port);
 }
 
-// `rosmaster --core -p PORT`, its output discarded (it logs to ROS_LOG_DIR).
+// `rosmaster --core -p PORT`, its output discarded (it logs to ROS_LOG_DIR). It ends with this process even when
+// this one is killed (PR_SET_PDEATHSIG), so no master outlives a bench stopped by a test's time limit.
 pid_t spawnMaster(int port) {
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, "/dev/null", O_WRONLY, 0);
   const std::string port_text = std::to_string(port);
-  std::vector<char*> argv = {const_cast<char*>("rosmaster"), const_cast<char*>("--core"), const_cast<char*>("-p"),
-                             const_cast<char*>(port_text.c_str()), nullptr};
-  pid_t pid = -1;
-  const int rc = posix_spawnp(&pid, "rosmaster", &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (rc != 0)
-    throw std::runtime_error(std::string("cannot start rosmaster (") + std::strerror(rc) +
-                             "): is ROS on PATH? `source scripts/env.sh`");
+  const pid_t parent = getpid();
+  const pid_t pid = fork();
+  if (pid < 0) throw std::runtime_error(std::string("fork: ") + std::strerror(errno));
+  if (pid == 0) {
+    prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (getppid() != parent) _exit(1);
+    const int null = open("/dev/null", O_WRONLY);
+    dup2(null, STDOUT_FILENO);
+    dup2(null, STDERR_FILENO);
+    execlp("rosmaster", "rosmaster", "--core", "-p", port_text.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
   return pid;
 }
 
-// After ros::init: the master (just started) answers, or a runtime_error after 15 s.
-void waitForMaster() {
+// After ros::init: the master (just started) answers, or a runtime_error after 15 s (at once when `master`, the
+// process, has ended).
+void waitForMaster(ChildProcess* master = nullptr) {
   for (const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(15.0); !ros::master::check();) {
+    if (master && master->ended())
+      throw std::runtime_error(master->exitCode() == 127 ? "rosmaster not found: is ROS on PATH? (`source scripts/env.sh`)"
+                                                         : "rosmaster ended at start (exit code " +
+                                                               std::to_string(master->exitCode()) + ")");
     if (ros::WallTime::now() > deadline)
       throw std::runtime_error("the ROS master at " + ros::master::getURI() + " did not come up within 15 s");
     ros::WallDuration(0.1).sleep();
@@ -437,6 +441,7 @@ int runNodeletBench(const NodeletBenchOptions& o) {
   const pid_t player_pid = fork();
   if (player_pid < 0) throw std::runtime_error(std::string("fork: ") + std::strerror(errno));
   if (player_pid == 0) {
+    prctl(PR_SET_PDEATHSIG, SIGTERM);  // a killed bench takes its player along
     close(go[1]);
     int rc = 1;
     try {
@@ -455,7 +460,7 @@ int runNodeletBench(const NodeletBenchOptions& o) {
 
   ros::M_string no_remappings;
   ros::init(no_remappings, "ret3d_bench");
-  waitForMaster();
+  waitForMaster(&master);
   // The nodelets' INFO lines (listening on ..., warmed up) would bury the table; warnings and errors still show.
   if (ros::console::set_logger_level("ros", ros::console::levels::Warn)) ros::console::notifyLoggerLevelsChanged();
 
