@@ -319,14 +319,15 @@ CommandRegistrar reg("bench", "time the pipeline: through the nodelets on a bag,
   app.add_option("--tail", n.tail, "--bag: s to wait after the last cloud for its outputs")->capture_default_str();
   app.add_flag("--no-markers", a->no_markers, "--bag: without the MarkerNodelet (the launch file loads it)");
   app.add_option("--topic", a->topic, "bag topic (default: the first PointCloud2 topic)");
-  app.add_option("--models", p.models, "folder with detector.pt, intra_rm.pt, inter_rm.pt (e.g. models/lwd3d)");
+  app.add_option("--models", p.models, "folder with detector.pt, intra_rm.pt, inter_rm.pt (e.g. models/lwd3d; "
+                                 "--bag: that is the default, as in launch/ret3d.launch)");
   app.add_option("--detector-model", p.detector_model, "detector model file (overrides --models)");
   app.add_option("--intra-model", p.intra_model, "IntraRM model file (overrides --models)");
   app.add_option("--inter-model", p.inter_model, "InterRM model file (overrides --models)");
   app.add_option("--detector-config", p.detector_config, "detector YAML (default: the config in the model file)");
   app.add_option("--tracker-config", p.tracker_config,
                  "tracker YAML (default: built-in values; --bag: the one config/ret3d.yaml names)");
-  app.add_option("--score-threshold", p.score_threshold, "detector score threshold (default: the model's)");
+  app.add_option("--score-threshold", p.score_threshold, "detector score threshold (default: the model's; --bag: config/ret3d.yaml's)");
   app.add_option("--stages", a->stages, "comma-separated stages in order, starting with base")->capture_default_str();
   app.add_option("--threads", p.threads, "CPU threads for libtorch")->capture_default_str();
   app.add_option("--warmup", a->warmup, "untimed runs first (--bag: clouds left out of the statistics)")->capture_default_str();
