@@ -14,6 +14,7 @@
 #include <ros/ros.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
+#include <diagnostic_msgs/DiagnosticArray.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <tf2_msgs/TFMessage.h>
 #include <yaml-cpp/yaml.h>
@@ -394,13 +395,58 @@ struct Row {
   std::string name, what;
   std::vector<double> ms;
   std::size_t in = 0, out = 0;
+  double processing_p50 = -1, processing_p95 = -1;  // the stage's own /diagnostics (< 0: none)
 };
 
 void printRow(const Row& r, std::size_t frames) {
+  std::ostringstream processing;
+  processing << std::fixed << std::setprecision(1);
+  if (r.processing_p50 >= 0) processing << r.processing_p50 << " / " << r.processing_p95;
   std::cout << std::left << std::setw(12) << r.name << std::right << std::fixed << std::setprecision(1)
             << std::setw(10) << percentile(r.ms, 50) << std::setw(10) << percentile(r.ms, 95) << std::setw(6)
-            << r.out << "/" << std::left << std::setw(6) << (r.in ? r.in : frames) << r.what << "\n";
+            << r.out << "/" << std::left << std::setw(6) << (r.in ? r.in : frames) << std::right << std::setw(14)
+            << processing.str() << "  " << r.what << "\n";
 }
+
+// The stages' own reports on /diagnostics (src/ros/diagnostics.cpp): the last one of each nodelet, and when it came.
+class DiagnosticsRecorder {
+ public:
+  void onMessage(const diagnostic_msgs::DiagnosticArray::ConstPtr& msg) {
+    const double now = ros::WallTime::now().toSec();
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const diagnostic_msgs::DiagnosticStatus& s : msg->status) {
+      std::string nodelet = s.name.substr(0, s.name.find(':'));  // "/ret3d_detector: ..." -> "ret3d_detector"
+      if (!nodelet.empty() && nodelet.front() == '/') nodelet.erase(0, 1);
+      auto& last = last_[nodelet];
+      last.first = now;
+      for (const diagnostic_msgs::KeyValue& kv : s.values) last.second[kv.key] = kv.value;
+    }
+  }
+  // True when every one of `nodelets` has reported after wall time `since`.
+  bool reportedSince(const std::vector<std::string>& nodelets, double since) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const std::string& n : nodelets) {
+      const auto it = last_.find(n);
+      if (it == last_.end() || it->second.first <= since) return false;
+    }
+    return true;
+  }
+  // The value of `key` in the nodelet's last report, or -1.
+  double value(const std::string& nodelet, const std::string& key) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto it = last_.find(nodelet);
+    if (it == last_.end() || !it->second.second.count(key)) return -1;
+    try {
+      return std::stod(it->second.second.at(key));
+    } catch (const std::exception&) {
+      return -1;
+    }
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::map<std::string, std::pair<double, std::map<std::string, std::string>>> last_;
+};
 
 }  // namespace
 
@@ -511,6 +557,8 @@ int runNodeletBench(const NodeletBenchOptions& o) {
       else
         subscribers.push_back(record<ret3d::DetectionArray>(nh, stages[k].output, k + 1, &recorder));
     }
+    DiagnosticsRecorder diagnostics;
+    subscribers.push_back(nh.subscribe("/diagnostics", 100, &DiagnosticsRecorder::onMessage, &diagnostics));
     ros::AsyncSpinner spinner(2);
     spinner.start();
 
@@ -544,6 +592,12 @@ int runNodeletBench(const NodeletBenchOptions& o) {
       ros::WallDuration(0.02).sleep();
     }
     if (!ros::ok()) throw std::runtime_error("interrupted");
+    // The nodelets report once a second: one more report of each covers the last frames.
+    std::vector<std::string> nodelets;
+    for (const Stage& s : stages) nodelets.push_back(s.nodelet);
+    const double ended = ros::WallTime::now().toSec();
+    for (int i = 0; i < 150 && ros::ok() && !diagnostics.reportedSince(nodelets, ended); ++i)
+      ros::WallDuration(0.01).sleep();
     spinner.stop();
     subscribers.clear();
     loader.clear();
@@ -551,8 +605,11 @@ int runNodeletBench(const NodeletBenchOptions& o) {
 
     const auto measured = recorder.measured();
     frames = measured.size();
-    for (std::size_t k = 0; k < stages.size(); ++k)
+    for (std::size_t k = 0; k < stages.size(); ++k) {
       rows.emplace_back(stages[k].name, "  " + stages[k].input + " to " + stages[k].output + " (" + stages[k].type + ")");
+      rows.back().processing_p50 = diagnostics.value(stages[k].nodelet, "processing p50 (ms)");
+      rows.back().processing_p95 = diagnostics.value(stages[k].nodelet, "processing p95 (ms)");
+    }
     for (const auto& [stamp, at] : measured) {
       input.ms.push_back(1e3 * (at[0] - stamp));
       for (std::size_t k = 0; k < stages.size(); ++k) {
@@ -575,10 +632,12 @@ int runNodeletBench(const NodeletBenchOptions& o) {
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
   const std::size_t dropped = frames - frames_out;
   std::cout << std::left << std::setw(12) << "stage" << std::right << std::setw(10) << "p50 ms" << std::setw(10)
-            << "p95 ms" << std::setw(13) << "out/in" << "\n";
+            << "p95 ms" << std::setw(13) << "out/in" << std::setw(16) << "processing ms" << "\n";
   printRow(input, frames);
   for (const Row& r : rows) printRow(r, frames);
   printRow(end_to_end, frames);
+  std::cout << "(p50 / p95 per cloud after the warm-up: from the arrival of a stage's input to that of its output, "
+               "waiting included; processing p50 / p95: the stage's own /diagnostics over its last 200 frames)\n";
   std::cout << std::setprecision(1) << "frames: " << frames << " measured, " << frames_out << " with "
             << stages.back().output << ", " << dropped << " dropped (" << 100.0 * static_cast<double>(dropped) / std::max<std::size_t>(1, frames)
             << " %)\n"
@@ -591,7 +650,10 @@ int runNodeletBench(const NodeletBenchOptions& o) {
     json << std::fixed << std::setprecision(3) << "{";
     auto add = [&](const Row& r) {
       json << "\"" << r.name << "\": {\"median_ms\": " << percentile(r.ms, 50) << ", \"p95_ms\": " << percentile(r.ms, 95)
-           << ", \"frames_out\": " << r.out << "}, ";
+           << ", \"frames_out\": " << r.out;
+      if (r.processing_p50 >= 0)
+        json << ", \"processing_median_ms\": " << r.processing_p50 << ", \"processing_p95_ms\": " << r.processing_p95;
+      json << "}, ";
     };
     add(input);
     for (const Row& r : rows) add(r);
