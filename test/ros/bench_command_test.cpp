@@ -75,6 +75,10 @@ TEST_F(BenchCommand, BagThroughTheNodeletsReportsEveryStageEndToEndAndCpu) {
     EXPECT_GT(p50, 0.0) << key;
     EXPECT_GE(p95, p50) << key;
   }
+  // Beside each stage's input-to-output time, its own processing time from /diagnostics.
+  for (const char* key : {"base", "intra", "track", "inter"})
+    EXPECT_TRUE(j[key]["processing_median_ms"] && j[key]["processing_p95_ms"]) << key << "\n" << r.output;
+  EXPECT_GT(j["base"]["processing_median_ms"].as<double>(), 0.0) << r.output;
   // The latency from the cloud's stamp includes every stage on the way.
   EXPECT_GT(j["end_to_end"]["median_ms"].as<double>(), j["base"]["median_ms"].as<double>()) << r.output;
   // Every cloud after the warm-up is measured; each has /objects or counts as dropped.
