@@ -48,8 +48,13 @@ constexpr double kRate = 0.5;
 // Mean 3D AP R40 moderate over the three classes (KITTI devkit rules, front camera view; the figure the model card
 // selects heads by). The default models of models/lwd3d (2026-11-22) score 51.2 on this drive (Car 36.2, Pedestrian
 // 51.8, Cyclist 65.5), the same in repeated runs; the bound is about 70 % of it. An untrained detector scores 0.0.
+// The bound holds for this drive only: drives differ a lot (seed 4343 scores 34.7 with the same models).
 constexpr double kMinMeanAp = 35.0;
-constexpr double kMinIdStability = 90.0;  // percent of matched ground-truth track-frames (issue 8)
+// Percent of matched ground-truth track-frames (issue 8). With config/tracker_lwd3d_all.yaml (every detection starts
+// a track) this drive measured 85.5 % (Car 91.4, Pedestrian 76.9, Cyclist 95.7): one object alternating between two
+// output tracks, pedestrians re-born outside their 0.4 m gate. Birth score 0.3 and a 0.8 m pedestrian gate gave
+// 94.9 % at the same AP.
+constexpr double kMinIdStability = 90.0;
 // The stability figure must speak for a fair share of the ground truth: the default models match 55.6 % of the
 // ground-truth track-frames of this drive (360 degrees, every range the simulator labels).
 constexpr double kMinIdCoverage = 30.0;
