@@ -106,18 +106,21 @@ def main():
     if args.metrics:
         with open(args.metrics) as f:
             m = json.load(f)
-        # metrics.json is flat: "kitti.<Class>.<3d|bev>.R40.moderate", "mot.<Class>.<MOTA|IDSW|HOTA>".
+        # metrics.json is flat: "kitti.<Class>.<3d|bev>.R40.moderate", "mot.<Class>.<MOTA|IDSW|HOTA|IdStability>".
         def cell(key, fmt):
             v = m.get(key)
             return format(v, fmt) if v is not None else "-".rjust(len(format(0, fmt)))
 
         print(f"  scores    ret3d eval against the bag's /ground_truth/objects ({truth} frames):")
-        print("            KITTI AP R40 moderate (front camera view); CLEAR MOT and HOTA (3D IoU >= 0.5)")
-        print("            class        3D AP  BEV AP    MOTA  IDSW    HOTA")
+        print("            KITTI AP R40 moderate (front camera view); CLEAR MOT and HOTA (3D IoU >= 0.5); ids stable:")
+        print("            % of covered ground-truth track-frames under their track's most frequent id (centres < 2 m)")
+        print("            class        3D AP  BEV AP    MOTA  IDSW    HOTA  ids stable")
         for name in CLASSES.values():
             print(f"            {name:<11} {cell(f'kitti.{name}.3d.R40.moderate', '7.2f')}"
                   f" {cell(f'kitti.{name}.bev.R40.moderate', '7.2f')} {cell(f'mot.{name}.MOTA', '7.2f')}"
-                  f" {cell(f'mot.{name}.IDSW', '5d')} {cell(f'mot.{name}.HOTA', '7.2f')}")
+                  f" {cell(f'mot.{name}.IDSW', '5.0f')} {cell(f'mot.{name}.HOTA', '7.2f')}"
+                  f" {cell(f'mot.{name}.IdStability', '11.1f')}")
+        print(f"            all classes{'':>38}{cell('mot.all.IdStability', '11.1f')}")
     if args.report:
         print(f"  report    {args.report} (plots beside it)")
     return 0

@@ -42,7 +42,7 @@ print("mean        %8.2f %8.2f %8.2f %9.2f %9.2f" % (sum(m["kitti.%s.3d.R40.mode
       sum(m["kitti.%s.bev.R40.moderate" % c] for c in classes) / 3, m["waymo.mean.L1.APH"], m["waymo.mean.L2.AP"],
       m["waymo.mean.L2.APH"]))
 for k in sorted(m):
-    if k.startswith("mot.") and (k.endswith(".MOTA") or k.endswith(".IDSW") or k.endswith(".HOTA")):
+    if k.startswith("mot.") and (k.endswith(".MOTA") or k.endswith(".IDSW") or k.endswith(".HOTA") or k.endswith(".IdStability")):
         print("%s %.2f" % (k, m[k]))
 print("(KITTI 3D/BEV AP R40 at moderate difficulty, Car @0.7, Pedestrian/Cyclist @0.5; report " + out + "/eval/report.md)")
 PY

@@ -172,6 +172,14 @@ std::map<std::string, double> metricsMap(const EvalReport& r) {
       m[q + "LocA"] = c.hota.loca;
     }
   }
+  if (r.id_stability) {
+    auto add = [&m](const std::string& name, const IdStabilityCounts& c) {
+      m["mot." + name + ".IdStability"] = c.stability();
+      m["mot." + name + ".IdCoverage"] = c.coverage();
+    };
+    for (const auto& c : r.id_stability->classes) add(className(c.cls), c.counts);
+    add("all", r.id_stability->all);
+  }
   return m;
 }
 
@@ -431,6 +439,23 @@ std::vector<std::string> writeReport(const std::string& dir, const EvalReport& r
          << fmt(c.hota.assa) << " | " << c.clear.num_gt << " | " << c.clear.tp << " | " << c.clear.fp << " | "
          << c.clear.fn << " | " << c.clear.num_gt_tracks << " | " << c.num_pred_tracks << " |\n";
     }
+    md << "\n";
+  }
+  if (r.id_stability) {
+    md << "## Track-id stability\n\n"
+       << "Of the ground-truth track-frames an output object covers (per frame and class, Hungarian on centre "
+          "distance < "
+       << fmt(r.id_stability_options.max_center_distance)
+       << " m), the share whose output id is the one that ground-truth track was covered by most often (stability); "
+          "coverage = covered / all ground-truth track-frames. Percent.\n\n"
+       << "| class | stability | coverage | GT track-frames | covered | stable | GT tracks covered | output ids |\n"
+          "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+    auto row = [&md](const std::string& name, const IdStabilityCounts& c) {
+      md << "| " << name << " | " << fmt(c.stability()) << " | " << fmt(c.coverage()) << " | " << c.gt_track_frames
+         << " | " << c.matched << " | " << c.stable << " | " << c.gt_tracks << " | " << c.output_ids << " |\n";
+    };
+    for (const auto& c : r.id_stability->classes) row(className(c.cls), c.counts);
+    row("all", r.id_stability->all);
     md << "\n";
   }
   writeFile(pathJoin(dir, "report.md"), md.str());

@@ -225,6 +225,7 @@ int runEval(const EvalArgs& a) {
     report.waymo_options.progress = nullptr;
   }
   MotResult mot;
+  IdStabilityResult id_stability;
   if (metrics.count("mot")) {
     if (!data.gt_has_track_ids || !data.pred_has_track_ids) {
       const std::string why = !data.gt_has_track_ids ? "the ground truth has no track ids"
@@ -249,6 +250,9 @@ int runEval(const EvalArgs& a) {
       mot = evaluateMot(data.frames, o);
       report.mot = &mot;
       report.mot_options = o;
+      report.id_stability_options.classes = classes;
+      id_stability = evaluateIdStability(data.frames, report.id_stability_options);
+      report.id_stability = &id_stability;
     }
   }
   const auto t_end = std::chrono::steady_clock::now();

@@ -66,6 +66,8 @@ TEST(Report, WritesMetricsJsonReportAndPlots) {
   r.kitti_loose = &kitti;
   r.waymo = &waymo;
   r.mot = &mot;
+  const IdStabilityResult ids = evaluateIdStability(frames);
+  r.id_stability = &ids;
 
   const auto m = metricsMap(r);
   for (const char* key : {"kitti.Car.3d.R11.easy", "kitti.Car.bev.R40.moderate", "kitti.Pedestrian.2d.R40.hard",
@@ -78,6 +80,9 @@ TEST(Report, WritesMetricsJsonReportAndPlots) {
   EXPECT_NEAR(m.at("waymo.Car.L1.APH"), 100.0, 1e-9);
   EXPECT_NEAR(m.at("mot.Car.MOTA"), 100.0, 1e-9);
   EXPECT_NEAR(m.at("mot.Car.MT"), 100.0, 1e-9);  // percent of ground-truth tracks
+  EXPECT_NEAR(m.at("mot.Car.IdStability"), 100.0, 1e-9);  // predictions = ground truth: one id per track
+  EXPECT_NEAR(m.at("mot.all.IdStability"), 100.0, 1e-9);
+  EXPECT_NEAR(m.at("mot.all.IdCoverage"), 100.0, 1e-9);
 
   test::TempDir dir;
   const auto pngs = writeReport(dir / "report", r);
@@ -87,7 +92,7 @@ TEST(Report, WritesMetricsJsonReportAndPlots) {
   EXPECT_EQ(json.front(), '{');
   const std::string md = readAll(dir / "report/report.md");
   for (const char* text : {"## Inputs", "unit test ground truth", "KITTI object detection AP", "Waymo-style",
-                           "CLEAR MOT", "| Car |"}) {
+                           "CLEAR MOT", "| Car |", "Track-id stability", "| all | 100.00 |"}) {
     EXPECT_NE(md.find(text), std::string::npos) << text;
   }
   if (pngs.empty()) GTEST_SKIP() << "gnuplot is not installed: no plots to check";

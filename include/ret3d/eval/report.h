@@ -5,6 +5,7 @@
 //   kitti.<Class>.<3d|bev|2d|aos>.<R11|R40>.<easy|moderate|hard>     strict IoU 0.7 / 0.5 / 0.5
 //   waymo.<Class|mean>.<L1|L2>.<AP|APH>
 //   mot.<Class>.<MOTA|MOTP|IDSW|FRAG|MT|ML|HOTA|DetA|AssA>            IDSW, FRAG: counts; MT, ML: % of GT tracks
+//   mot.<Class|all>.<IdStability|IdCoverage>                          eval/id_stability.h (centre distance < 2 m)
 // and, under other prefixes: kitti_loose.* (IoU 0.5 / 0.25 / 0.25, same layout as kitti.*), waymo_range.<Class>.
 // <0-30|30-50|50+>.<L1|L2>.<AP|APH>, mot_detail.<Class>.<...> (TP, FP, FN, PT, GT tracks, DetRe, DetPr, AssRe,
 // AssPr, LocA), count.* (frames, objects, ground truth per difficulty).
@@ -14,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "ret3d/eval/id_stability.h"
 #include "ret3d/eval/kitti_ap.h"
 #include "ret3d/eval/mot_metrics.h"
 #include "ret3d/eval/waymo_ap.h"
@@ -33,6 +35,8 @@ struct EvalReport {
   WaymoOptions waymo_options;
   const MotResult* mot = nullptr;
   MotOptions mot_options;
+  const IdStabilityResult* id_stability = nullptr;  // with the tracking metrics
+  IdStabilityOptions id_stability_options;
 };
 
 // All numbers of the report under their metrics.json keys (sorted).
