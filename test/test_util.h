@@ -3,7 +3,9 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <optional>
+#include <sstream>
 #include <string>
 
 namespace ret3d {
@@ -46,6 +48,14 @@ class TempDir {
  private:
   std::string path_;
 };
+
+// The whole file as a string ("" when it cannot be read).
+inline std::string readText(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
 
 }  // namespace test
 }  // namespace ret3d

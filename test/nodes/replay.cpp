@@ -29,12 +29,7 @@ namespace {
 
 constexpr int kFrames = 10;
 
-std::string readText(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using test::readText;
 
 TEST(Replay, EveryCloudGivesObjectsInTheRecordedBag) {
   const char* package = std::getenv("RET3D_PACKAGE_DIR");

@@ -59,12 +59,7 @@ constexpr double kMinIdStability = 90.0;
 // ground-truth track-frames of this drive (360 degrees, every range the simulator labels).
 constexpr double kMinIdCoverage = 30.0;
 
-std::string readText(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using test::readText;
 
 // The built `ret3d` command: devel/bin beside this node's devel/lib/ret3d, else whatever PATH finds.
 std::string cliPath() {
