@@ -259,7 +259,7 @@ int playBag(const NodeletBenchOptions& o, const BagPlan& plan, int go_fd) {
       if (const auto msg = m.instantiate<tf2_msgs::TFMessage>()) tf_static.publish(msg);
     } else if (const auto msg = m.instantiate<tf2_msgs::TFMessage>()) {
       for (geometry_msgs::TransformStamped& t : msg->transforms)
-        t.header.stamp = wall(t.header.stamp - ros::Duration(plan.stamp_skew));
+        if (!t.header.stamp.isZero()) t.header.stamp = wall(t.header.stamp - ros::Duration(plan.stamp_skew));
       waitUntil(wall(m.getTime()));
       tf.publish(msg);
     }
