@@ -3,7 +3,7 @@
 #   trains InterRM for every history length N (config/relation/inter_lwd3d.yaml with max_history N) and every
 #   positional encoding (config/relation/inter_lwd3d_pe_*.yaml, N = the shipped one) on the default models' boxes
 #   over the relation set (urban, seeds 3000-3011: sequences 0-9 train, 10-11 validation), then runs
-#   base + IntraRM + tracker (every detection tracked) + InterRM on the held-out set (scripts/eval_heldout.sh: urban
+#   base + IntraRM + the pipeline's tracker + InterRM on the held-out set (scripts/eval_heldout.sh: urban
 #   seeds 9000-9004, 500 frames) and times tracker + InterRM for 50 tracks with full histories (`ret3d bench`).
 #   Prints one row per configuration and writes the tables between the inter-sim-history and inter-sim-pe markers
 #   of docs/RESULTS.md.
@@ -20,7 +20,7 @@ MODELS=${MODELS:-models/lwd3d}
 HISTORIES=${HISTORIES-1 5 10 30 60 100}
 PES=${PES-temporal spatial}
 TRACKER=config/tracker_lwd3d.yaml          # InterRM trains on confidently tracked objects
-TRACKER_EVAL=config/tracker_lwd3d_all.yaml # and runs behind the pipeline's tracker: every detection tracked
+TRACKER_EVAL=config/tracker_lwd3d_pipeline.yaml  # and runs behind the pipeline's tracker
 # Results of other models are stale: start afresh when the detector or IntraRM changed.
 stamp=$(md5sum "$MODELS/detector.pt" "$MODELS/intra_rm.pt" | cut -c1-32 | tr -d '\n')
 if [ "$(cat "$OUT/models.md5" 2>/dev/null)" != "$stamp" ]; then rm -rf "$OUT" out/heldout/sim_inter_* out/heldout/sim_intra_track; fi
