@@ -159,7 +159,8 @@ void writeJson(const std::string& path, const std::string& text) {
 
 // Without the base stage: the relation stages and the tracker per frame on synthetic frames of --objects objects
 // (the graph and the tracks are built inside), so their cost is known for crowded scenes no drive provides. The
-// objects move at constant velocity, so tracks persist and their histories fill up (history_length frames).
+// objects move at constant velocity, so tracks persist and their histories fill up (warm-up: at least the history
+// length, in frames).
 int benchSynthetic(const BenchArgs& a) {
   OfflinePipeline p(a.pipeline);
   std::cout << "bench: " << p.describe() << "; " << a.pipeline.threads << " threads, " << a.warmup
@@ -191,7 +192,7 @@ int benchSynthetic(const BenchArgs& a) {
       p.reset();
       ++cases;
       // Warm-up frames fill the track histories first (the cost grows with their length).
-      const int warm = std::max(a.warmup, p.tracks() ? a.history_frames : 0);
+      const int warm = std::max(a.warmup, p.tracks() ? std::max(a.history_frames, p.historyLength()) : 0);
       for (int k = 0; k < warm + a.min_runs; ++k) {
         if (k == warm) p.clearTimes();
         Detections f = d;

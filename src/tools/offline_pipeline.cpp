@@ -88,6 +88,7 @@ OfflinePipeline::OfflinePipeline(const PipelineConfig& c) : stages_(c.stages) {
     // As in the ROS pipeline (the InterRM nodelet keeps max_history boxes per track), the history InterRM sees is
     // its model's max_history, whatever the tracker config says.
     if (inter_) t.history_length = inter_->arch().max_history;
+    history_length_ = t.history_length;
     tracking_ = std::make_unique<train::TrackingRefiner>(t, inter_.get());
     desc << "; tracker " << (c.tracker_config.empty() ? "built-in defaults" : c.tracker_config);
   }

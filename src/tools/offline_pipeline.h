@@ -52,6 +52,7 @@ class OfflinePipeline {
 
   bool hasBase() const { return static_cast<bool>(detector_); }
   bool tracks() const { return static_cast<bool>(tracking_); }
+  int historyLength() const { return history_length_; }  // boxes kept per track (0 without tracking)
   const Detector* detector() const { return detector_.get(); }
   // Length of the detector features IntraRM expects with each box (0: none, or no IntraRM stage).
   std::size_t intraFeatureDim() const;
@@ -73,6 +74,7 @@ class OfflinePipeline {
   std::unique_ptr<Detector> detector_;
   std::unique_ptr<relation::IntraRM> intra_;
   std::unique_ptr<relation::InterRM> inter_;
+  int history_length_ = 0;
   std::unique_ptr<train::TrackingRefiner> tracking_;
   StageTimes times_;
 };
