@@ -6,7 +6,7 @@
 #   base + IntraRM + the pipeline's tracker + InterRM on the held-out set (scripts/eval_heldout.sh: urban
 #   seeds 9000-9004, 500 frames) and times tracker + InterRM for 50 tracks with full histories (`ret3d bench`).
 #   Prints one row per configuration and writes the tables between the inter-sim-history and inter-sim-pe markers
-#   of docs/RESULTS.md.
+#   of docs/RESULTS.md, and the Table 3 analogue (table3-sim markers) with the shipped history length.
 #   scripts/ablate_inter_sim.sh            (two trainings at a time, one thread each; ~1 min per training)
 #   HISTORIES="1 10 30" scripts/ablate_inter_sim.sh
 # Work files: out/ablate_inter_sim/. Needs models/lwd3d/{detector,intra_rm}.pt.
@@ -64,3 +64,10 @@ for c in "${NAMES[@]}"; do
       --objects 50 --json "$OUT/$c.bench.json" >"$OUT/$c.bench.log" 2>&1
 done
 python3 scripts/results_table.py inter "$OUT" "${NAMES[@]}"
+# Table 3 analogue with the shipped history length (config/relation/inter_lwd3d.yaml), when its rows are all there
+# (base and + IntraRM come from scripts/ablate_intra_sim.sh).
+shipped=$(sed -n 's/^ *max_history: *\([0-9]*\).*/\1/p' config/relation/inter_lwd3d.yaml)
+if [ -f out/heldout/base/eval/metrics.json ] && [ -f out/heldout/intra_lwd3d/eval/metrics.json ] &&
+  [ -f "out/heldout/sim_inter_h$shipped/eval/metrics.json" ]; then
+  python3 scripts/results_table.py table3 "inter_h$shipped"
+fi

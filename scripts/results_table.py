@@ -4,6 +4,7 @@
 
   results_table.py intra OUT_DIR CONFIG...   # rows: base, then base + each IntraRM
   results_table.py inter OUT_DIR NAME...     # rows: + IntraRM + tracker, then + each InterRM (history, encoding)
+  results_table.py table3 INTER_NAME         # Ret3D Table 3 analogue: base, + IntraRM, + tracker, + InterRM
 """
 import json
 import os
@@ -31,6 +32,15 @@ def train_seconds(log, marker):
         if marker in line:
             return "%.0f" % float(line.split(" in ")[1].split(" s")[0])
     return ""
+
+
+def shipped_history():
+    """max_history of config/relation/inter_lwd3d.yaml, the shipped InterRM's config."""
+    for line in open("config/relation/inter_lwd3d.yaml"):
+        m = re.match(r"\s*max_history:\s*(\d+)", line)
+        if m:
+            return int(m.group(1))
+    raise SystemExit("config/relation/inter_lwd3d.yaml: no max_history")
 
 
 def write_between(key, lines):
@@ -86,7 +96,7 @@ def inter_tables(out, names):
     pes = [n for n in names if n.startswith("inter_pe_")]
     if pes:
         lines = [head[0] % "positional encoding", head[1], base]
-        shipped = [n for h, n in hist if h == 30]
+        shipped = [n for h, n in hist if h == shipped_history()]
         if shipped:
             lines.append(inter_row(out, shipped[0], "implicit (time offset as an input feature)"))
         label = {"temporal": "temporal (sinusoids of the time offset)", "spatial": "spatial (sinusoids of the position)"}
@@ -95,7 +105,41 @@ def inter_tables(out, names):
         write_between("inter-sim-pe", lines)
 
 
+def table3(inter_name):
+    rows = [("base (LWD-3D, anchor head)", "base"), ("+ IntraRM", "intra_lwd3d"),
+            ("+ IntraRM + tracker", "sim_intra_track"), ("+ IntraRM + tracker + InterRM", "sim_" + inter_name)]
+    waymo = ["| stages | " + " | ".join("%s L1 mAP/mAPH | %s L2 mAP/mAPH" % (c, c) for c in CLASSES) +
+             " | mean L2 mAP | **mean L2 mAPH** |", "| --- " * (2 + 2 * len(CLASSES) + 1) + "|"]
+    kitti = ["| stages | Car 3D @0.7 | Pedestrian 3D @0.5 | Cyclist 3D @0.5 | Car BEV @0.7 | mean L2 mAPH |",
+             "| --- | --- | --- | --- | --- | --- |"]
+    mot = ["| stages | class | MOTA | MOTP | IDSW | IDSW per 100 GT tracks | HOTA | DetA | AssA | id stability % |",
+           "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+    for label, name in rows:
+        m = metrics(name)
+        cells = []
+        for c in CLASSES:
+            for lv in ("L1", "L2"):
+                cells.append("%.2f / %.2f" % (m["waymo.%s.%s.AP" % (c, lv)], m["waymo.%s.%s.APH" % (c, lv)]))
+        waymo.append("| " + " | ".join([label] + cells + ["%.2f" % m["waymo.mean.L2.AP"],
+                                                          "**%.2f**" % m["waymo.mean.L2.APH"]]) + " |")
+        kitti.append("| " + " | ".join([label] + ["%.2f" % m["kitti.%s.3d.R40.moderate" % c] for c in CLASSES] + [
+            "%.2f" % m["kitti.Car.bev.R40.moderate"], "%.2f" % m["waymo.mean.L2.APH"]]) + " |")
+        if "mot.Car.MOTA" in m:
+            for c in CLASSES:
+                p = "mot.%s." % c
+                tracks = max(1.0, m["mot_detail.%s.GT_tracks" % c])
+                mot.append("| %s | %s | %.2f | %.2f | %d | %.1f | %.2f | %.2f | %.2f | %.1f |" % (
+                    label, c, m[p + "MOTA"], m[p + "MOTP"], m[p + "IDSW"], 100.0 * m[p + "IDSW"] / tracks,
+                    m[p + "HOTA"], m[p + "DetA"], m[p + "AssA"], m.get(p + "IdStability", float("nan"))))
+    lines = waymo + [""] + kitti + [""] + mot
+    print("\n".join(lines))
+    write_between("table3-sim", lines)
+
+
 if __name__ == "__main__":
-    if len(sys.argv) < 3 or sys.argv[1] not in ("intra", "inter"):
+    if len(sys.argv) == 3 and sys.argv[1] == "table3":
+        table3(sys.argv[2])
+    elif len(sys.argv) >= 3 and sys.argv[1] in ("intra", "inter"):
+        (intra_table if sys.argv[1] == "intra" else inter_tables)(sys.argv[2], sys.argv[3:])
+    else:
         sys.exit(__doc__)
-    (intra_table if sys.argv[1] == "intra" else inter_tables)(sys.argv[2], sys.argv[3:])
