@@ -322,6 +322,29 @@ double cpuSecondsOfThisProcess() {
          1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
+// Ticks of the whole machine from /proc/stat: {steal, all}. Steal is time the hypervisor gave the virtual CPUs to
+// someone else; on a shared virtual machine it explains latencies no code change would. {0, 0} when unreadable.
+std::pair<double, double> machineTicks() {
+  std::ifstream in("/proc/stat");
+  std::string cpu;
+  in >> cpu;
+  if (cpu != "cpu") return {0, 0};
+  double v[8] = {0, 0, 0, 0, 0, 0, 0, 0}, all = 0;  // user nice system idle iowait irq softirq steal
+  for (double& x : v) {
+    in >> x;
+    all += x;
+  }
+  return in ? std::make_pair(v[7], all) : std::make_pair(0.0, 0.0);
+}
+
+struct Usage {
+  double wall = 0, cpu = 0, steal_ticks = 0, all_ticks = 0;
+  static Usage now() {
+    const auto [steal, all] = machineTicks();
+    return {ros::WallTime::now().toSec(), cpuSecondsOfThisProcess(), steal, all};
+  }
+};
+
 // When each cloud (by its stamp) reached the manager (slot 0) and each stage's output (slot k) appeared; and the CPU
 // this process used from the first measured cloud to the last output.
 class Recorder {
@@ -333,8 +356,8 @@ class Recorder {
     auto& at = arrivals_[stamp.toNSec()];
     if (at.empty()) at.assign(slots_, std::nan(""));
     if (std::isnan(at[slot])) at[slot] = receipt.toSec();
-    if (slot == 0 && ++clouds_ == warmup_ + 1) cpu_start_ = {ros::WallTime::now().toSec(), cpuSecondsOfThisProcess()};
-    if (slot + 1 == slots_ && clouds_ > warmup_) cpu_end_ = {ros::WallTime::now().toSec(), cpuSecondsOfThisProcess()};
+    if (slot == 0 && ++clouds_ == warmup_ + 1) start_ = Usage::now();
+    if (slot + 1 == slots_ && clouds_ > warmup_) end_ = Usage::now();
   }
   // Clouds seen, and how many of them have the last stage's output.
   std::pair<std::size_t, std::size_t> progress() const {
@@ -358,19 +381,24 @@ class Recorder {
     }
     return out;
   }
-  // CPU cores used (CPU seconds per wall second) over the measured window; and the window's length.
-  std::pair<double, double> cpu() const {
+  // Over the measured window: CPU cores used by this process (CPU seconds per wall second), the window's length (s),
+  // and the machine's steal time (percent of all CPU time).
+  struct Cpu {
+    double cores = 0, seconds = 0, steal_percent = 0;
+  };
+  Cpu cpu() const {
     std::lock_guard<std::mutex> lock(mutex_);
-    const double wall = cpu_end_.first - cpu_start_.first;
-    if (wall <= 0) return {0.0, 0.0};
-    return {(cpu_end_.second - cpu_start_.second) / wall, wall};
+    const double wall = end_.wall - start_.wall;
+    if (wall <= 0) return {};
+    const double all = end_.all_ticks - start_.all_ticks;
+    return {(end_.cpu - start_.cpu) / wall, wall, all > 0 ? 100.0 * (end_.steal_ticks - start_.steal_ticks) / all : 0.0};
   }
 
  private:
   mutable std::mutex mutex_;
   std::size_t slots_, warmup_, clouds_ = 0;
   std::map<std::uint64_t, std::vector<double>> arrivals_;
-  std::pair<double, double> cpu_start_{0, 0}, cpu_end_{0, 0};  // wall s, CPU s
+  Usage start_, end_;
 };
 
 template <typename M>
@@ -514,7 +542,7 @@ int runNodeletBench(const NodeletBenchOptions& o) {
   std::vector<Row> rows;
   Row end_to_end{"end_to_end", "  stamp to " + stages.back().output};
   std::size_t frames = 0, frames_out = 0;
-  std::pair<double, double> cpu{0, 0};
+  Recorder::Cpu cpu;
   double player_cpu = 0;
   {
     ros::NodeHandle nh, private_nh("~");
@@ -641,9 +669,12 @@ int runNodeletBench(const NodeletBenchOptions& o) {
   std::cout << std::setprecision(1) << "frames: " << frames << " measured, " << frames_out << " with "
             << stages.back().output << ", " << dropped << " dropped (" << 100.0 * static_cast<double>(dropped) / std::max<std::size_t>(1, frames)
             << " %)\n"
-            << std::setprecision(2) << "CPU: " << cpu.first << " cores of " << cores << " (" << std::setprecision(0)
-            << 100.0 * cpu.first / cores << " %) used by the manager process over the " << std::setprecision(1)
-            << cpu.second << " s measured; the player used " << player_cpu << " s of CPU in all\n";
+            << std::setprecision(2) << "CPU: " << cpu.cores << " cores of " << cores << " (" << std::setprecision(0)
+            << 100.0 * cpu.cores / cores << " %) used by the manager process over the " << std::setprecision(1)
+            << cpu.seconds << " s measured; the player used " << player_cpu << " s of CPU in all\n"
+            << "machine: " << cpu.steal_percent
+            << " % of CPU time stolen by the hypervisor meanwhile (/proc/stat steal; above a few percent the timings "
+               "say more about the host than about the pipeline)\n";
 
   if (!o.json.empty()) {
     std::ostringstream json;
@@ -660,7 +691,8 @@ int runNodeletBench(const NodeletBenchOptions& o) {
     add(end_to_end);
     json << "\"frames\": " << frames << ", \"frames_out\": " << frames_out << ", \"dropped\": " << dropped
          << ", \"warmup\": " << o.warmup << ", \"input_rate_hz\": " << plan.cloud_rate_hz * o.rate
-         << ", \"cpu_cores\": " << cpu.first << ", \"cpu_percent\": " << 100.0 * cpu.first / cores
+         << ", \"cpu_cores\": " << cpu.cores << ", \"cpu_percent\": " << 100.0 * cpu.cores / cores
+         << ", \"steal_percent\": " << cpu.steal_percent
          << ", \"cores\": " << cores << ", \"threads\": " << o.threads << "}\n";
     if (fs::path(o.json).has_parent_path()) fs::create_directories(fs::path(o.json).parent_path());
     std::ofstream(o.json) << json.str();
