@@ -67,7 +67,7 @@ python3 scripts/results_table.py inter "$OUT" "${NAMES[@]}"
 # Table 3 analogue with the shipped history length (config/relation/inter_lwd3d.yaml), when its rows are all there
 # (base and + IntraRM come from scripts/ablate_intra_sim.sh).
 shipped=$(sed -n 's/^ *max_history: *\([0-9]*\).*/\1/p' config/relation/inter_lwd3d.yaml)
-if [ -f out/heldout/base/eval/metrics.json ] && [ -f out/heldout/intra_lwd3d/eval/metrics.json ] &&
+if [ -f out/heldout/base/eval/metrics.json ] && [ -f out/heldout/intra_lwd3d_m1/eval/metrics.json ] &&
   [ -f "out/heldout/sim_inter_h$shipped/eval/metrics.json" ]; then
   python3 scripts/results_table.py table3 "inter_h$shipped"
 fi
