@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <map>
 #include <memory>
+#include <stdexcept>
 
 #include "tools/train_command.h"
 
@@ -44,6 +45,29 @@ void DetectorSource::addOptions(CLI::App& app) {
                  "this package's detector model: run on --data's scans (boxes and features, cached in OUT.dets)");
   app.add_option("--detections-cache", cache, "with --detector: the cache file (default OUT.dets)");
   app.add_option("--score-threshold", score_threshold, "with --detector: its score threshold (default: the model's)");
+}
+
+void RelationTrainArgs::addOptions(CLI::App& app, const std::string& data_help, const std::string& detections_help,
+                                    const std::string& config_help) {
+  app.add_option("--data", data, data_help);
+  app.add_option("--detections", detections, detections_help);
+  detector.addOptions(app);
+  app.add_option("--out", out, "model file to write");
+  app.add_option("--config", config, config_help);
+  app.add_option("--sequences", sequences, "training sequences, e.g. 1-15 (default: all labelled)");
+  app.add_option("--val-sequences", val_sequences, "validation sequences: the best epoch's model is kept");
+  app.add_option("--epochs", epochs, "override train.epochs");
+  app.add_option("--threads", threads, "CPU threads for libtorch")->capture_default_str();
+  app.add_option("--checkpoint", checkpoint, "checkpoint folder (default: OUT.ckpt)");
+  app.add_flag("--resume", resume, "continue from the checkpoint");
+  app.add_flag("--quiet", quiet, "no progress bar");
+  app.add_option("--inspect", inspect, "print a model file's metadata and exit");
+}
+
+void RelationTrainArgs::validate() const {
+  if (data.empty() || out.empty()) throw std::runtime_error("--data and --out are required");
+  if (detections.empty() == !detector.given())
+    throw std::runtime_error("give one of --detections DIR (another detector's results) or --detector MODEL");
 }
 
 io::SequenceDetections DetectorSource::run(const std::string& data, const std::string& sequences, int threads,

@@ -35,5 +35,21 @@ struct DetectorSource {
                              const std::string& default_cache, const std::string& suffix) const;
 };
 
+// What `ret3d train intra` and `ret3d train inter` share: the data and the boxes to refine (another detector's
+// results or this package's detector), the output and checkpoint, the schedule, and --inspect.
+struct RelationTrainArgs {
+  std::string data, detections, out, config, sequences, val_sequences, checkpoint, inspect;
+  DetectorSource detector;
+  int epochs = -1, threads = 2;
+  bool resume = false, quiet = false;
+  std::string command_line;  // stored in the model file
+
+  // The help of --data, --detections and --config names what the module reads.
+  void addOptions(CLI::App& app, const std::string& data_help, const std::string& detections_help,
+                  const std::string& config_help);
+  // Throws std::runtime_error unless --data and --out are given with exactly one source of boxes.
+  void validate() const;
+};
+
 }  // namespace tools
 }  // namespace ret3d

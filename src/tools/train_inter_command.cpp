@@ -18,12 +18,8 @@ namespace ret3d {
 namespace tools {
 namespace {
 
-struct TrainInterArgs {
-  std::string data, detections, intra_model, tracker_config, out, config, sequences, val_sequences, checkpoint, inspect;
-  DetectorSource detector;
-  int epochs = -1, threads = 2;
-  bool resume = false, quiet = false;
-  std::string command_line;
+struct TrainInterArgs : RelationTrainArgs {
+  std::string intra_model, tracker_config;
 };
 
 int runTrainInter(const TrainInterArgs& a) {
@@ -34,9 +30,7 @@ int runTrainInter(const TrainInterArgs& a) {
               << relation::toYaml(info.config) << std::endl;
     return 0;
   }
-  if (a.data.empty() || a.out.empty()) throw std::runtime_error("--data and --out are required");
-  if (a.detections.empty() == !a.detector.given())
-    throw std::runtime_error("give one of --detections DIR (another detector's results) or --detector MODEL");
+  a.validate();
   relation::setTorchThreads(a.threads);
   train::InterTrainOptions opt;
   opt.config = a.config.empty() ? relation::InterRMConfig{} : relation::loadInterRMConfig(a.config);
@@ -88,22 +82,11 @@ int runTrainInter(const TrainInterArgs& a) {
 TrainRegistrar reg("inter", "InterRM (Ret3D inter-frame relation module) on tracked detections",
                    [](CLI::App& app) -> CommandRun {
   auto a = std::make_shared<TrainInterArgs>();
-  app.add_option("--data", a->data, "KITTI tracking root with labels, calibration and poses (pose/ or oxts/)");
-  app.add_option("--detections", a->detections,
-                 "detector outputs: KITTI tracking result files or per-class CSV folders");
-  a->detector.addOptions(app);
+  a->addOptions(app, "KITTI tracking root with labels, calibration and poses (pose/ or oxts/)",
+                 "detector outputs: KITTI tracking result files or per-class CSV folders",
+                 "InterRM YAML config (default: built-in = config/relation/inter_rm.yaml)");
   app.add_option("--intra-model", a->intra_model, "IntraRM model run on each frame before tracking (optional)");
   app.add_option("--tracker-config", a->tracker_config, "tracker YAML (default: built-in = config/tracker.yaml)");
-  app.add_option("--out", a->out, "model file to write");
-  app.add_option("--config", a->config, "InterRM YAML config (default: built-in = config/relation/inter_rm.yaml)");
-  app.add_option("--sequences", a->sequences, "training sequences, e.g. 1-15 (default: all labelled)");
-  app.add_option("--val-sequences", a->val_sequences, "validation sequences: the best epoch's model is kept");
-  app.add_option("--epochs", a->epochs, "override train.epochs");
-  app.add_option("--threads", a->threads, "CPU threads for libtorch")->capture_default_str();
-  app.add_option("--checkpoint", a->checkpoint, "checkpoint folder (default: OUT.ckpt)");
-  app.add_flag("--resume", a->resume, "continue from the checkpoint");
-  app.add_flag("--quiet", a->quiet, "no progress bar");
-  app.add_option("--inspect", a->inspect, "print a model file's metadata and exit");
   return [a, &app]() {
     a->command_line = commandLine("ret3d train inter", app);
     return runTrainInter(*a);

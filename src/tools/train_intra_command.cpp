@@ -15,13 +15,7 @@ namespace ret3d {
 namespace tools {
 namespace {
 
-struct TrainIntraArgs {
-  std::string data, detections, out, config, sequences, val_sequences, checkpoint, inspect;
-  DetectorSource detector;
-  int epochs = -1, threads = 2;
-  bool resume = false, quiet = false;
-  std::string command_line;
-};
+using TrainIntraArgs = RelationTrainArgs;
 
 int runTrainIntra(const TrainIntraArgs& a) {
   if (!a.inspect.empty()) {
@@ -31,9 +25,7 @@ int runTrainIntra(const TrainIntraArgs& a) {
               << relation::toYaml(info.config) << std::endl;
     return 0;
   }
-  if (a.data.empty() || a.out.empty()) throw std::runtime_error("--data and --out are required");
-  if (a.detections.empty() == !a.detector.given())
-    throw std::runtime_error("give one of --detections DIR (another detector's results) or --detector MODEL");
+  a.validate();
   relation::setTorchThreads(a.threads);
   train::IntraTrainOptions opt;
   opt.config = a.config.empty() ? relation::IntraRMConfig{} : relation::loadIntraRMConfig(a.config);
@@ -82,20 +74,9 @@ int runTrainIntra(const TrainIntraArgs& a) {
 TrainRegistrar reg("intra", "IntraRM (Ret3D intra-frame relation module) on another detector's boxes",
                    [](CLI::App& app) -> CommandRun {
   auto a = std::make_shared<TrainIntraArgs>();
-  app.add_option("--data", a->data, "KITTI tracking (or object) root with labels and calibration");
-  app.add_option("--detections", a->detections,
-                 "detector outputs: KITTI object/tracking result files or per-class CSV folders");
-  a->detector.addOptions(app);
-  app.add_option("--out", a->out, "model file to write");
-  app.add_option("--config", a->config, "IntraRM YAML config (default: built-in = config/relation/intra_rm.yaml)");
-  app.add_option("--sequences", a->sequences, "training sequences, e.g. 1-15 (default: all labelled)");
-  app.add_option("--val-sequences", a->val_sequences, "validation sequences: the best epoch's model is kept");
-  app.add_option("--epochs", a->epochs, "override train.epochs");
-  app.add_option("--threads", a->threads, "CPU threads for libtorch")->capture_default_str();
-  app.add_option("--checkpoint", a->checkpoint, "checkpoint folder (default: OUT.ckpt)");
-  app.add_flag("--resume", a->resume, "continue from the checkpoint");
-  app.add_flag("--quiet", a->quiet, "no progress bar");
-  app.add_option("--inspect", a->inspect, "print a model file's metadata and exit");
+  a->addOptions(app, "KITTI tracking (or object) root with labels and calibration",
+                 "detector outputs: KITTI object/tracking result files or per-class CSV folders",
+                 "IntraRM YAML config (default: built-in = config/relation/intra_rm.yaml)");
   return [a, &app]() {
     a->command_line = commandLine("ret3d train intra", app);
     return runTrainIntra(*a);
