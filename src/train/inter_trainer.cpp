@@ -18,6 +18,8 @@
 #include "ret3d/relation/intra_rm.h"
 #include "ret3d/relation/intra_rm_targets.h"
 
+#include "epoch_loop.h"
+
 namespace ret3d {
 namespace train {
 
@@ -173,55 +175,23 @@ InterTrainReport trainInterRM(const std::vector<InterRMSample>& train, const std
                                                                          << V0.size << " yaw " << V0.yaw << ")");
   }
   const auto t0 = std::chrono::steady_clock::now();
-  const std::size_t bs = static_cast<std::size_t>(cfg.train.sequences_per_batch);
-  const std::size_t batches = (train.size() + bs - 1) / bs;
-  for (int epoch = start_epoch; epoch < cfg.train.epochs; ++epoch) {
-    // The shuffle depends only on the seed and the epoch, so a resumed run sees the same order.
-    std::vector<std::size_t> order(train.size());
-    std::iota(order.begin(), order.end(), 0);
-    std::mt19937_64 rng(cfg.train.seed * 1000003ULL + static_cast<std::uint64_t>(epoch));
-    std::shuffle(order.begin(), order.end(), rng);
-    double sum = 0;
-    std::unique_ptr<ProgressBar> bar;
-    if (options.progress)
-      bar = std::make_unique<ProgressBar>(
-          "InterRM epoch " + std::to_string(epoch + 1) + "/" + std::to_string(cfg.train.epochs), batches);
-    for (std::size_t b = 0; b < batches; ++b) {
-      std::vector<const InterRMSample*> batch;
-      for (std::size_t k = b * bs; k < std::min(train.size(), (b + 1) * bs); ++k) batch.push_back(&train[order[k]]);
-      const relation::InterRMLoss L = learner.step(batch);
-      if (epoch == start_epoch && b == 0) report.first_train_loss = L.total;
-      sum += L.total;
-      if (bar) {
-        std::ostringstream info;
-        info.precision(4);
-        info << "loss " << L.total << " (loc " << L.loc << " size " << L.size << " yaw " << L.yaw << ")";
-        bar->tick(1, info.str());
-      }
-    }
-    if (bar) bar->finish();
-    report.last_train_loss = sum / static_cast<double>(batches);
-    std::ostringstream msg;
-    msg << "InterRM epoch " << epoch + 1 << ": train loss " << report.last_train_loss;
-    if (!val.empty()) {
-      const relation::InterRMLoss V = learner.evaluate(val);
-      report.val_losses.push_back(V.total);
-      msg << ", validation loss " << V.total << " (loc " << V.loc << " size " << V.size << " yaw " << V.yaw << ")";
-      if (V.total < best_val) {
-        best_val = V.total;
-        report.best_epoch = epoch + 1;
-        learner.model().save(options.out_path);
-        msg << " - best, saved";
-      }
-    }
-    RET3D_INFO(msg.str());
-    learner.saveCheckpoint(ckpt, epoch + 1, best_val);
-    report.epochs_run = epoch + 1;
-  }
-  if (val.empty()) {
-    learner.model().save(options.out_path);
-    report.best_epoch = report.epochs_run;
-  } else if (report.best_epoch == 0) {
+  EpochLoopSettings loop;
+  loop.name = "InterRM";
+  loop.start_epoch = start_epoch;
+  loop.epochs = cfg.train.epochs;
+  loop.seed = cfg.train.seed;
+  loop.batch_size = static_cast<std::size_t>(cfg.train.sequences_per_batch);
+  loop.out_path = options.out_path;
+  loop.checkpoint = ckpt;
+  loop.progress = options.progress;
+  const std::function<std::string(const relation::InterRMLoss&)> parts = [](const relation::InterRMLoss& L) {
+    std::ostringstream o;
+    o << "(loc " << L.loc << " size " << L.size << " yaw " << L.yaw << ")";
+    return o.str();
+  };
+  runEpochs<relation::InterRMLearner, InterRMSample, relation::InterRMLoss>(loop, learner, train, val, parts,
+                                                           &best_val, &report);
+  if (!val.empty() && report.best_epoch == 0) {
     RET3D_WARN("InterRM: no epoch improved on the input boxes' validation loss; " << options.out_path
                                                                                   << " is the identity module");
   }

@@ -16,6 +16,8 @@
 #include "ret3d/io/detections.h"
 #include "ret3d/io/kitti.h"
 
+#include "epoch_loop.h"
+
 namespace ret3d {
 namespace train {
 
@@ -161,56 +163,23 @@ IntraTrainReport trainIntraRM(const std::vector<IntraRMFrame>& train, const std:
     learner.fitNormalisation(train);
   }
   const auto t0 = std::chrono::steady_clock::now();
-  const std::size_t bs = static_cast<std::size_t>(cfg.train.frames_per_batch);
-  const std::size_t batches = (train.size() + bs - 1) / bs;
-  for (int epoch = start_epoch; epoch < cfg.train.epochs; ++epoch) {
-    // The shuffle depends only on the seed and the epoch, so a resumed run sees the same order.
-    std::vector<std::size_t> order(train.size());
-    std::iota(order.begin(), order.end(), 0);
-    std::mt19937_64 rng(cfg.train.seed * 1000003ULL + static_cast<std::uint64_t>(epoch));
-    std::shuffle(order.begin(), order.end(), rng);
-    double sum = 0;
-    std::unique_ptr<ProgressBar> bar;
-    if (options.progress)
-      bar = std::make_unique<ProgressBar>("IntraRM epoch " + std::to_string(epoch + 1) + "/" +
-                                              std::to_string(cfg.train.epochs),
-                                          batches);
-    for (std::size_t b = 0; b < batches; ++b) {
-      std::vector<const IntraRMFrame*> batch;
-      for (std::size_t k = b * bs; k < std::min(train.size(), (b + 1) * bs); ++k) batch.push_back(&train[order[k]]);
-      const relation::IntraRMLoss L = learner.step(batch);
-      if (epoch == start_epoch && b == 0) report.first_train_loss = L.total;
-      sum += L.total;
-      if (bar) {
-        std::ostringstream info;
-        info.precision(4);
-        info << "loss " << L.total << " (cls " << L.cls << " reg " << L.reg << " dir " << L.dir << ")";
-        bar->tick(1, info.str());
-      }
-    }
-    if (bar) bar->finish();
-    report.last_train_loss = sum / static_cast<double>(batches);
-    std::ostringstream msg;
-    msg << "IntraRM epoch " << epoch + 1 << ": train loss " << report.last_train_loss;
-    if (!val.empty()) {
-      const relation::IntraRMLoss V = learner.evaluate(val);
-      report.val_losses.push_back(V.total);
-      msg << ", validation loss " << V.total << " (cls " << V.cls << " reg " << V.reg << " dir " << V.dir << ")";
-      if (V.total < best_val) {
-        best_val = V.total;
-        report.best_epoch = epoch + 1;
-        learner.model().save(options.out_path);
-        msg << " - best, saved";
-      }
-    }
-    RET3D_INFO(msg.str());
-    learner.saveCheckpoint(ckpt, epoch + 1, best_val);
-    report.epochs_run = epoch + 1;
-  }
-  if (val.empty()) {
-    learner.model().save(options.out_path);
-    report.best_epoch = report.epochs_run;
-  }
+  EpochLoopSettings loop;
+  loop.name = "IntraRM";
+  loop.start_epoch = start_epoch;
+  loop.epochs = cfg.train.epochs;
+  loop.seed = cfg.train.seed;
+  loop.batch_size = static_cast<std::size_t>(cfg.train.frames_per_batch);
+  loop.out_path = options.out_path;
+  loop.checkpoint = ckpt;
+  loop.progress = options.progress;
+  const std::function<std::string(const relation::IntraRMLoss&)> parts = [](const relation::IntraRMLoss& L) {
+    std::ostringstream o;
+    o << "(cls " << L.cls << " reg " << L.reg << " dir " << L.dir << ")";
+    return o.str();
+  };
+  runEpochs<relation::IntraRMLearner, IntraRMFrame, relation::IntraRMLoss>(loop, learner, train, val, parts,
+                                                          &best_val, &report);
+
   report.best_val_loss = best_val;
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return report;
