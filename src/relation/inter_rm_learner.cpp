@@ -12,6 +12,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "inter_rm_network.h"
+#include "learner_checkpoint.h"
 #include "ret3d/core/geometry.h"
 
 namespace ret3d {
@@ -160,34 +161,11 @@ void InterRMLearner::setTrainedOn(const std::string& text) { impl_->model.impl()
 void InterRMLearner::saveCheckpoint(const std::string& dir, int epoch, double best_val) const {
   fs::create_directories(dir);
   impl_->model.save(dir + "/model.pt");
-  torch::save(*impl_->optimizer, dir + "/optimizer.pt");
-  YAML::Node s;
-  s["epoch"] = epoch;
-  s["best_val"] = best_val;
-  std::ostringstream rng;
-  rng << impl_->rng;
-  s["rng"] = rng.str();
-  const std::string tmp = dir + "/state.yaml.tmp";
-  {
-    std::ofstream out(tmp);
-    YAML::Emitter e;
-    e << s;
-    out << e.c_str() << "\n";
-  }
-  fs::rename(tmp, dir + "/state.yaml");
+  writeLearnerCheckpoint(dir, *impl_->optimizer, epoch, best_val, impl_->rng);
 }
 
 bool InterRMLearner::loadCheckpoint(const std::string& dir, int* epoch, double* best_val) {
-  if (!fs::exists(dir + "/state.yaml")) return false;
-  try {
-    const YAML::Node s = YAML::LoadFile(dir + "/state.yaml");
-    *epoch = s["epoch"].as<int>();
-    *best_val = s["best_val"].as<double>();
-    std::istringstream rng(s["rng"].as<std::string>());
-    rng >> impl_->rng;
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error("InterRM checkpoint " + dir + "/state.yaml: unreadable (" + std::string(e.what()) + ")");
-  }
+  if (!readLearnerState(dir, "InterRM", epoch, best_val, &impl_->rng)) return false;
   InterRMOptions o;
   o.model_path = dir + "/model.pt";
   InterRM saved(o);
@@ -198,18 +176,8 @@ bool InterRMLearner::loadCheckpoint(const std::string& dir, int* epoch, double* 
       a.regress_size != b.regress_size)
     throw std::runtime_error("InterRM checkpoint " + dir + ": its network differs from the configuration (" +
                              toYaml({a, {}}) + ")");
-  torch::NoGradGuard no_grad;
-  auto dst_p = impl_->net()->named_parameters();
-  for (const auto& p : saved.impl().net->named_parameters()) dst_p[p.key()].copy_(p.value());
-  auto dst_b = impl_->net()->named_buffers();
-  for (const auto& bb : saved.impl().net->named_buffers()) dst_b[bb.key()].copy_(bb.value());
-  try {
-    torch::load(*impl_->optimizer, dir + "/optimizer.pt");
-  } catch (const std::exception& e) {
-    std::string msg = e.what();
-    throw std::runtime_error("InterRM checkpoint " + dir + "/optimizer.pt: unreadable (" +
-                             msg.substr(0, msg.find('\n')) + ")");
-  }
+  copyWeights(*saved.impl().net, *impl_->net());
+  readLearnerOptimizer(dir, "InterRM", impl_->optimizer.get());
   return true;
 }
 
