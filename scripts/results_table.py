@@ -85,9 +85,9 @@ def inter_tables(out, names):
     head = ["| %s | Car 3D @0.7 | Ped 3D @0.5 | Cyc 3D @0.5 | L2 mAP | L2 mAPH | Car MOTA | Car HOTA | "
             "tracker + InterRM ms, 50 tracks (median / p95) | train s |",
             "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
-    base = "| " + " | ".join(["+ IntraRM + tracker, no InterRM"] + ap_cells(metrics("sim_intra_track")) + [
-        "%.1f" % metrics("sim_intra_track")["mot.Car.MOTA"], "%.1f" % metrics("sim_intra_track")["mot.Car.HOTA"], "",
-        ""]) + " |"
+    tracked = metrics("sim_intra_track")
+    base = "| " + " | ".join(["+ IntraRM + tracker, no InterRM"] + ap_cells(tracked) + [
+        "%.1f" % tracked["mot.Car.MOTA"], "%.1f" % tracked["mot.Car.HOTA"], "", ""]) + " |"
     hist = sorted((int(re.match(r"inter_h(\d+)$", n).group(1)), n) for n in names if re.match(r"inter_h\d+$", n))
     lines = [head[0] % "history N (implicit encoding)", head[1], base]
     lines += [inter_row(out, n, "N = %d" % h) for h, n in hist]
