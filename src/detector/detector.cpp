@@ -73,8 +73,12 @@ Detections Detector::detect(const PointCloud& current, const PointCloud* previou
   const auto keep = rotatedNms(candidates, options_.inference.nms_iou, true,
                                static_cast<std::size_t>(std::max(0, options_.inference.max_detections)));
   Detections det;
-  det.boxes.reserve(keep.size());
-  for (std::size_t i : keep) det.boxes.push_back(candidates[i]);
+  if (options_.inference.nms_voting_iou > 0) {
+    det.boxes = voteBoxes(candidates, keep, options_.inference.nms_voting_iou);
+  } else {
+    det.boxes.reserve(keep.size());
+    for (std::size_t i : keep) det.boxes.push_back(candidates[i]);
+  }
   timings_.nms_ms = msSince(t0);
 
   // The features o_i belong to decoding (Ret3D §3.1): timed with it.

@@ -144,6 +144,7 @@ void readModel(MapReader r, ModelConfig* m) {
     a.get("anchors_per_class", &m->anchor.anchors_per_class);
     a.get("scale_fraction", &m->anchor.scale_fraction);
     a.get("neighbour_cells", &m->anchor.neighbour_cells);
+    a.get("iou_quality", &m->anchor.iou_quality);
     a.finish();
   }
   {
@@ -163,7 +164,11 @@ void readInference(MapReader r, InferenceOptions* o) {
   r.get("max_candidates", &o->max_candidates);
   r.get("max_detections", &o->max_detections);
   r.get("nms_iou", &o->nms_iou);
+  r.get("nms_voting_iou", &o->nms_voting_iou);
+  r.get("iou_score_power", &o->iou_score_power);
   r.finish();
+  if (!(o->iou_score_power >= 0 && o->iou_score_power <= 1)) r.fail(r.full("iou_score_power"), "must lie in [0, 1]");
+  if (!(o->nms_voting_iou >= 0 && o->nms_voting_iou <= 1)) r.fail(r.full("nms_voting_iou"), "must lie in [0, 1]");
   if (o->threads < 1) r.fail(r.full("threads"), "must be >= 1");
 }
 
@@ -190,6 +195,7 @@ void readTrain(MapReader r, TrainOptions* t) {
   r.get("supervised_fov_deg", &t->supervised_fov_deg);
   r.get("loss_weight_regression", &t->loss_weight_regression);
   r.get("loss_weight_velocity", &t->loss_weight_velocity);
+  r.get("loss_weight_iou", &t->loss_weight_iou);
   r.finish();
   if (t->epochs < 1) r.fail(r.full("epochs"), "must be >= 1");
   if (t->batch_size < 1) r.fail(r.full("batch_size"), "must be >= 1");
@@ -269,6 +275,7 @@ std::string modelConfigToYaml(const ModelConfig& m) {
   e << YAML::Key << "anchors_per_class" << YAML::Value << m.anchor.anchors_per_class;
   e << YAML::Key << "scale_fraction" << YAML::Value << m.anchor.scale_fraction;
   e << YAML::Key << "neighbour_cells" << YAML::Value << m.anchor.neighbour_cells;
+  e << YAML::Key << "iou_quality" << YAML::Value << m.anchor.iou_quality;
   e << YAML::EndMap;
   e << YAML::Key << "center" << YAML::Value << YAML::BeginMap;
   e << YAML::Key << "stride" << YAML::Value << m.center.stride;

@@ -96,6 +96,7 @@ class AnchorHead : public DetectionHead {
   AnchorHead(const ModelConfig& c, const std::vector<Anchor>& anchors) : config_(c) {
     C_ = static_cast<int>(c.classes.size());
     D_ = 1 + C_ + kBoxCodeSize;
+    quality_ = c.anchor.iou_quality;
     for (int s : c.anchor.strides) per_stride_[s];
     for (const Anchor& a : anchors) {
       if (!per_stride_.count(a.stride))
@@ -110,32 +111,35 @@ class AnchorHead : public DetectionHead {
     }
   }
 
+  // Per stride: A blocks of D channels (objectness, classes, box code), then A IoU-quality channels if enabled.
   std::map<int, int> outputChannels() const override {
     std::map<int, int> m;
-    for (const auto& [s, a] : per_stride_) m[s] = static_cast<int>(a.size()) * D_;
+    for (const auto& [s, a] : per_stride_) m[s] = static_cast<int>(a.size()) * (D_ + (quality_ ? 1 : 0));
     return m;
   }
 
   void initBias(LwdNetworkImpl& net) const override {
-    for (const auto& kv : per_stride_) net.initClassificationBias(kv.first, 0, 1, D_, 0.01);
+    for (const auto& kv : per_stride_)
+      net.initClassificationBias(kv.first, 0, 1, D_, 0.01, static_cast<int>(kv.second.size()) * D_);
   }
 
   HeadLoss loss(const NetworkOutput& out, const std::vector<GroundTruth>& gt, const BevGeometry& g,
                 const TrainOptions& t) const override {
     HeadLoss L;
     L.total = torch::zeros({});
-    torch::Tensor obj_sum = torch::zeros({}), cls_sum = torch::zeros({});
+    torch::Tensor obj_sum = torch::zeros({}), cls_sum = torch::zeros({}), iou_sum = torch::zeros({});
     std::vector<torch::Tensor> preds, targets, valids;
     int64_t positives = 0;
     for (const auto& [stride, anchors] : per_stride_) {
       const auto& raw = out.head.at(stride);
       const int N = static_cast<int>(raw.size(0)), h = static_cast<int>(raw.size(2)), w = static_cast<int>(raw.size(3));
       const int A = static_cast<int>(anchors.size());
-      auto r = raw.view({N, A, D_, h, w}).permute({0, 1, 3, 4, 2});  // N A h w D
+      auto r = raw.narrow(1, 0, A * D_).reshape({N, A, D_, h, w}).permute({0, 1, 3, 4, 2});  // N A h w D
       auto obj_t = torch::zeros({N, A, h, w});
       auto weight = torch::ones({N, A, h, w});
       std::vector<int64_t> idx_n, idx_a, idx_v, idx_u, cls;
       std::vector<float> codes, vvalid;
+      std::vector<const Box*> pos_box;  // the object of each positive
       for (int n = 0; n < N; ++n) {
         weight[n].mul_(supervisionMask(gt[n], g, stride, h, w).unsqueeze(0));
         for (std::size_t bi = 0; bi < gt[n].boxes.size(); ++bi) {
@@ -169,6 +173,7 @@ class AnchorHead : public DetectionHead {
               const BoxCode code = encodeAnchorBox(b, anchors[a], u, v, stride, g, config_.sweep_interval);
               codes.insert(codes.end(), code.begin(), code.end());
               vvalid.push_back(velocityValid(gt[n], bi) ? 1.0f : 0.0f);
+              pos_box.push_back(&b);
             }
           }
         }
@@ -185,6 +190,7 @@ class AnchorHead : public DetectionHead {
       auto reg = sel.index({Slice(), Slice(1 + C_, D_)});
       // The centre offset is 2 sigmoid - 0.5 (YOLOv5), the rest raw.
       reg = torch::cat({2 * torch::sigmoid(reg.index({Slice(), Slice(0, 2)})) - 0.5, reg.index({Slice(), Slice(2, kBoxCodeSize)})}, 1);
+      if (quality_) iou_sum = iou_sum + qualityLoss(raw, A, reg, idx_n, idx_a, idx_v, idx_u, pos_box, anchors, stride, g);
       preds.push_back(reg);
       targets.push_back(torch::from_blob(codes.data(), {P, kBoxCodeSize}).clone());
       valids.push_back(torch::tensor(vvalid));
@@ -194,6 +200,11 @@ class AnchorHead : public DetectionHead {
     L.total = obj + cl;
     L.parts.emplace_back("obj", obj.item<double>());
     L.parts.emplace_back("cls", cl.item<double>());
+    if (quality_) {
+      auto iou = iou_sum / norm;
+      L.total = L.total + t.loss_weight_iou * iou;
+      L.parts.emplace_back("iou", iou.item<double>());
+    }
     if (!preds.empty()) {
       regressionLosses(torch::cat(preds), torch::cat(targets), torch::cat(valids), t, &L.total, &L.parts);
     } else {
@@ -210,9 +221,14 @@ class AnchorHead : public DetectionHead {
       const auto& raw = out.head.at(stride)[sample];
       const int h = static_cast<int>(raw.size(1)), w = static_cast<int>(raw.size(2));
       const int A = static_cast<int>(anchors.size());
-      auto r = raw.view({A, D_, h, w});
+      auto r = raw.narrow(0, 0, A * D_).reshape({A, D_, h, w});
       auto score = torch::sigmoid(r.index({Slice(), Slice(0, 1)})) *
                    torch::softmax(r.index({Slice(), Slice(1, 1 + C_)}), 1);  // A x C x h x w
+      if (quality_) {
+        const double p = o.iou_score_power;
+        auto iou = torch::sigmoid(raw.narrow(0, A * D_, A)).unsqueeze(1);  // A x 1 x h x w
+        score = score.pow(1 - p) * iou.pow(p);
+      }
       auto reg = r.index({Slice(), Slice(1 + C_, D_)}).contiguous();       // A x 10 x h x w
       auto ra = reg.accessor<float, 4>();
       for (int c = 0; c < C_; ++c) {
@@ -240,8 +256,33 @@ class AnchorHead : public DetectionHead {
   }
 
  private:
+  // BCE between the IoU channel at each positive and the 3D IoU of the box decoded there (prediction detached: the
+  // channel learns to judge the box, not to move it) with its object.
+  torch::Tensor qualityLoss(const torch::Tensor& raw, int A, const torch::Tensor& reg, const std::vector<int64_t>& idx_n,
+                            const std::vector<int64_t>& idx_a, const std::vector<int64_t>& idx_v,
+                            const std::vector<int64_t>& idx_u, const std::vector<const Box*>& objects,
+                            const std::vector<Anchor>& anchors, int stride, const BevGeometry& g) const {
+    const int64_t P = static_cast<int64_t>(idx_n.size());
+    auto codes = reg.detach().contiguous();
+    auto ca = codes.accessor<float, 2>();
+    std::vector<float> target(P);
+    for (int64_t i = 0; i < P; ++i) {
+      BoxCode code;
+      for (int k = 0; k < kBoxCodeSize; ++k) code[k] = ca[i][k];
+      const Box b = decodeAnchorBox(code, anchors[idx_a[i]], static_cast<int>(idx_u[i]), static_cast<int>(idx_v[i]),
+                                    stride, g, config_.sweep_interval);
+      target[i] = static_cast<float>(iou3d(b, *objects[i]));
+    }
+    auto opt = torch::TensorOptions().dtype(torch::kLong);
+    auto q = raw.narrow(1, A * D_, A).index({torch::tensor(idx_n, opt), torch::tensor(idx_a, opt),
+                                             torch::tensor(idx_v, opt), torch::tensor(idx_u, opt)});
+    return F::binary_cross_entropy_with_logits(q, torch::tensor(target),
+                                               F::BinaryCrossEntropyWithLogitsFuncOptions().reduction(torch::kSum));
+  }
+
   ModelConfig config_;
   int C_ = 0, D_ = 0;
+  bool quality_ = false;
   std::map<int, std::vector<Anchor>> per_stride_;
 };
 

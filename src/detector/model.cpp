@@ -89,6 +89,44 @@ std::unique_ptr<DetectorModel> DetectorModel::load(const std::string& path, cons
   return model;
 }
 
+std::unique_ptr<DetectorModel> DetectorModel::extend(const std::string& path, const ModelConfig& config,
+                                                     std::vector<std::string>* fresh) {
+  auto from = load(path);
+  ModelConfig base = config;
+  base.anchor.iou_quality = from->config().anchor.iou_quality;
+  const auto diffs = diffModelConfigs(from->config(), base);
+  if (!diffs.empty() || (from->config().anchor.iou_quality && !config.anchor.iou_quality)) {
+    std::string msg = path + ": cannot start the configured model from this file:";
+    for (const auto& d : diffs) msg += "\n  " + d + " (file vs config)";
+    if (diffs.empty()) msg += "\n  model.anchor.iou_quality: true vs false (the config would drop outputs)";
+    throw ModelFileError(msg);
+  }
+  auto model = std::make_unique<DetectorModel>(config, from->anchors());
+  torch::NoGradGuard no_grad;
+  const auto source = from->net->named_parameters(true);
+  const auto source_buffers = from->net->named_buffers(true);
+  auto copy = [&](const std::string& name, torch::Tensor& dst, const torch::Tensor* src) {
+    if (!src) {
+      if (fresh) fresh->push_back(name);
+      return;
+    }
+    if (src->sizes() == dst.sizes()) {
+      dst.copy_(*src);
+      return;
+    }
+    // A layer that gained output channels (dim 0): the old ones lead.
+    if (src->dim() == dst.dim() && src->size(0) < dst.size(0) && src->sizes().slice(1) == dst.sizes().slice(1)) {
+      dst.narrow(0, 0, src->size(0)).copy_(*src);
+      if (fresh) fresh->push_back(name);
+      return;
+    }
+    throw ModelFileError(path + ": tensor " + name + " has an unexpected shape");
+  };
+  for (auto& p : model->net->named_parameters(true)) copy(p.key(), p.value(), source.find(p.key()));
+  for (auto& b : model->net->named_buffers(true)) copy(b.key(), b.value(), source_buffers.find(b.key()));
+  return model;
+}
+
 torch::Tensor bevToTensor(const BevImage& img) {
   return torch::from_blob(const_cast<float*>(img.data.data()), {1, img.channels, img.height, img.width}).clone();
 }

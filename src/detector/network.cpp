@@ -123,12 +123,12 @@ NetworkOutput LwdNetworkImpl::forward(const torch::Tensor& bev) {
   return out;
 }
 
-void LwdNetworkImpl::initClassificationBias(int stride, int first, int count, int period, double prior) {
+void LwdNetworkImpl::initClassificationBias(int stride, int first, int count, int period, double prior, int end) {
   auto& seq = heads.at(stride);
   auto conv = seq->ptr(seq->size() - 1)->as<torch::nn::Conv2dImpl>();
   torch::NoGradGuard ng;
   const double b = -std::log((1.0 - prior) / prior);
-  const int total = static_cast<int>(conv->bias.size(0));
+  const int total = end > 0 ? end : static_cast<int>(conv->bias.size(0));
   for (int start = first; start < total; start += period)
     for (int k = 0; k < count && start + k < total; ++k) conv->bias[start + k].fill_(b);
 }

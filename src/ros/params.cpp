@@ -162,6 +162,8 @@ DetectorNodeletParams loadDetectorNodeletParams(const ros::NodeHandle& private_n
   inf.threads = p.integer("threads", inf.threads, 1, 64);
   inf.score_threshold = static_cast<float>(p.number("score_threshold", inf.score_threshold, 0.0, 1.0));
   inf.nms_iou = p.number("nms_iou", inf.nms_iou, 0.01, 1.0);
+  inf.nms_voting_iou = p.number("nms_voting_iou", inf.nms_voting_iou, 0.0, 1.0);
+  inf.iou_score_power = p.number("iou_score_power", inf.iou_score_power, 0.0, 1.0);
   inf.max_detections = p.integer("max_detections", inf.max_detections, 1, 100000);
   const std::string scaling =
       p.choice("intensity_scaling", "auto", {"auto", "datatype", "observed_max", "fixed"});

@@ -2,8 +2,8 @@
 // for the object layout, one per sequence (tracking result format, with track ids after `track`/`inter`) for the
 // tracking layout.
 //   ret3d detect --data data/sim_test_urban --models models/lwd3d --out out/pred --stages base
-//   ret3d detect --detections ../shared/data/kitti_tracking/detections/pointrcnn --stages intra \
-//                --intra-model models/kitti_pointrcnn/intra_rm.pt --data ../shared/data/kitti_tracking \
+//   ret3d detect --detections ../shared/data/kitti_tracking/detections/pointrcnn --stages intra
+//                --intra-model models/kitti_pointrcnn/intra_rm.pt --data ../shared/data/kitti_tracking
 //                --sequences 16-20 --out out/pred_intra
 // With the `base` stage the boxes come from the LWD-3D detector on the folder's scans (the previous sweep moved by
 // the ego motion of pose/ or oxts/); without it they come from another detector's result files (--detections:
@@ -96,7 +96,7 @@ std::vector<kitti::Label> toLabels(const Detections& d, const kitti::Calibration
 
 // True when ROOT (or ROOT/training) holds velodyne/FFFFFF.bin files directly: the object layout.
 bool isObjectLayout(const std::string& root) {
-  for (const fs::path dir : {fs::path(root) / "training" / "velodyne", fs::path(root) / "velodyne"}) {
+  for (const fs::path& dir : {fs::path(root) / "training" / "velodyne", fs::path(root) / "velodyne"}) {
     if (!fs::is_directory(dir)) continue;
     for (const auto& e : fs::directory_iterator(dir))
       if (e.is_regular_file() && e.path().extension() == ".bin") return true;

@@ -22,8 +22,8 @@ CommandRun setup(CLI::App& app) {
   app.add_option("--out", job->out_model, "model file to write; checkpoints go beside it (<out>.ckpt*)")->required();
   app.add_flag("--resume", job->resume, "continue from <out>.ckpt when present");
   app.add_option("--init", job->init_model,
-                 "start from this model's weights (same model config) with a fresh optimiser and schedule; "
-                 "--resume still wins when <out>.ckpt exists")
+                 "start from this model's weights (same model config, or one that adds the IoU channels) with a fresh "
+                 "optimiser and schedule; --resume still wins when <out>.ckpt exists")
       ->check(CLI::ExistingFile);
   auto threads = std::make_shared<int>(0);
   app.add_option("--threads", *threads, "torch threads (default: the config's train.threads, else inference.threads)")

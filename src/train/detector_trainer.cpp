@@ -79,9 +79,12 @@ DetectorTrainResult trainDetector(const DetectorTrainJob& job) {
   } else if (!job.init_model.empty()) {
     if (job.resume)
       RET3D_INFO("--resume: no checkpoint at " << base << ".ckpt.state yet; starting from " << job.init_model);
-    // The config's model part must match the file's (load() refuses otherwise), so the anchors come from the file.
-    model = nn::DetectorModel::load(job.init_model, &o.model);
+    // The config's model part must match the file's, or only add outputs (extend() refuses otherwise); the anchors
+    // come from the file.
+    std::vector<std::string> fresh;
+    model = nn::DetectorModel::extend(job.init_model, o.model, &fresh);
     RET3D_INFO("starting from the weights of " << job.init_model << " (fresh optimiser and schedule)");
+    for (const std::string& name : fresh) RET3D_INFO("  " << name << ": new outputs start freshly initialised");
   } else {
     if (job.resume) RET3D_WARN("--resume: no checkpoint at " << base << ".ckpt.state; starting afresh");
     std::vector<Anchor> anchors;

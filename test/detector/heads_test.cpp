@@ -3,6 +3,7 @@
 #include "ret3d/detector/nn/heads.h"
 
 #include <cmath>
+#include <set>
 
 #include <gtest/gtest.h>
 
@@ -85,22 +86,22 @@ TEST(CenterHead, TargetsWrittenIntoTheMapDecodeBackToTheBoxes) {
   EXPECT_LT(good, 0.2 * bad);
 }
 
-TEST(AnchorHead, TargetsWrittenIntoTheMapDecodeBackToTheBoxesAtTheirScale) {
-  const ModelConfig m = smallConfig(HeadType::Anchor);
-  nn::DetectorModel model(m);  // default anchors, strides assigned
-  const auto& anchors = model.anchors();
-  const int C = 3, D = 1 + C + kBoxCodeSize;
+// Anchor-head maps that hold `boxes` exactly, each at the first anchor of its class (wherever it lives); with the
+// IoU-quality channels, those read `quality_logit` everywhere.
+nn::NetworkOutput anchorMaps(const ModelConfig& m, const std::vector<Anchor>& anchors, const std::vector<Box>& boxes,
+                             float quality_logit = 0) {
+  const int C = 3, D = 1 + C + kBoxCodeSize, Q = m.anchor.iou_quality ? 1 : 0;
   std::map<int, std::vector<Anchor>> per;
   for (const auto& a : anchors) per[a.stride].push_back(a);
-  ASSERT_EQ(per.size(), 2u);  // cars at stride 8, pedestrians and cyclists at stride 4
   nn::NetworkOutput out;
   for (const auto& [s, an] : per) {
-    auto raw = torch::zeros({1, static_cast<int64_t>(an.size()) * D, 128 / s, 128 / s});
-    for (std::size_t a = 0; a < an.size(); ++a) raw.index_put_({0, static_cast<int64_t>(a * D)}, -10.0f);
+    const int64_t A = static_cast<int64_t>(an.size());
+    auto raw = torch::zeros({1, A * (D + Q), 128 / s, 128 / s});
+    for (int64_t a = 0; a < A; ++a) raw.index_put_({0, a * D}, -10.0f);
+    if (Q) raw.index_put_({0, Slice(A * D, A * (D + 1))}, quality_logit);
     out.head[s] = raw;
   }
-  for (const Box& b : someBoxes()) {
-    // The first anchor of the box's class, wherever it lives.
+  for (const Box& b : boxes) {
     for (const auto& [s, an] : per) {
       for (std::size_t a = 0; a < an.size(); ++a) {
         if (an[a].label != b.label) continue;
@@ -119,10 +120,54 @@ TEST(AnchorHead, TargetsWrittenIntoTheMapDecodeBackToTheBoxesAtTheirScale) {
     }
   next:;
   }
+  return out;
+}
+
+TEST(AnchorHead, TargetsWrittenIntoTheMapDecodeBackToTheBoxesAtTheirScale) {
+  const ModelConfig m = smallConfig(HeadType::Anchor);
+  nn::DetectorModel model(m);  // default anchors, strides assigned
+  std::set<int> strides;
+  for (const auto& a : model.anchors()) strides.insert(a.stride);
+  ASSERT_EQ(strides.size(), 2u);  // cars at stride 8, pedestrians and cyclists at stride 4
   InferenceOptions o;
-  const auto boxes = model.head().decode(out, 0, m.geometry, o);
+  const auto boxes = model.head().decode(anchorMaps(m, model.anchors(), someBoxes()), 0, m.geometry, o);
   ASSERT_EQ(boxes.size(), 2u);
   for (const Box& b : someBoxes()) expectFound(boxes, b);
+}
+
+TEST(AnchorHead, IoUQualityChannelsRankTheBoxesAndLearnTheOverlap) {
+  ModelConfig m = smallConfig(HeadType::Anchor);
+  m.anchor.iou_quality = true;
+  nn::DetectorModel model(m);
+  const int per_anchor = 1 + 3 + kBoxCodeSize;
+  for (const auto& [s, ch] : model.head().outputChannels()) EXPECT_EQ(ch % (per_anchor + 1), 0) << "stride " << s;
+
+  // Decoding: the same boxes; the score is (objectness * class)^(1 - p) * IoU^p.
+  InferenceOptions o;
+  o.iou_score_power = 0.5;
+  const auto boxes = model.head().decode(anchorMaps(m, model.anchors(), someBoxes(), 0.0f), 0, m.geometry, o);
+  ASSERT_EQ(boxes.size(), 2u);
+  for (const Box& d : boxes) EXPECT_NEAR(d.score, std::sqrt(0.5), 1e-3) << className(d.label);  // IoU 0.5, rest ~1
+  o.iou_score_power = 0.0;
+  for (const Box& d : model.head().decode(anchorMaps(m, model.anchors(), someBoxes(), -3.0f), 0, m.geometry, o))
+    EXPECT_GT(d.score, 0.99f);
+
+  // Training: with one anchor per class and no neighbour cells, each box's only positive decodes it exactly, so
+  // the IoU target is 1; a channel that says so costs far less than one that says 0.05, and the loss reports it.
+  m.anchor.anchors_per_class = 1;
+  m.anchor.neighbour_cells = 0;
+  nn::DetectorModel one(m);
+  nn::GroundTruth gt;
+  gt.boxes = someBoxes();
+  TrainOptions t;
+  auto iouPart = [&](float q) {
+    const auto L = one.head().loss(anchorMaps(m, one.anchors(), someBoxes(), q), {gt}, m.geometry, t);
+    for (const auto& [name, v] : L.parts)
+      if (name == "iou") return v;
+    ADD_FAILURE() << "no iou part in the loss";
+    return 0.0;
+  };
+  EXPECT_LT(iouPart(6.0f), 0.1 * iouPart(-3.0f));
 }
 
 TEST(Heads, SupervisionMaskHonoursIgnoreBoxesAndFieldOfView) {

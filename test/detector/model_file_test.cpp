@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "ret3d/detector/box_coder.h"
 #include "ret3d/detector/detector.h"
 #include "ret3d/detector/nn/model.h"
 #include "test_util.h"
@@ -98,6 +99,43 @@ TEST(ModelFile, OtherMetadataIsRefusedSayingWhatDiffers) {
   }
   o.model = smallModel(HeadType::Anchor);
   EXPECT_THROW(Detector{o}, ModelFileError);
+}
+
+TEST(ModelFile, AModelThatAddsIoUQualityStartsFromTheWeightsOfOneWithout) {
+  test::TempDir dir;
+  const std::string path = dir / "m.ret3d";
+  torch::manual_seed(3);
+  nn::DetectorModel plain(smallModel(HeadType::Anchor));
+  plain.save(path);
+  ModelConfig with = smallModel(HeadType::Anchor);
+  with.anchor.iou_quality = true;
+  std::vector<std::string> fresh;
+  auto extended = nn::DetectorModel::extend(path, with, &fresh);
+  EXPECT_EQ(fresh, (std::vector<std::string>{"head4.1.weight", "head4.1.bias", "head8.1.weight", "head8.1.bias"}));
+  EXPECT_EQ(extended->anchors().size(), plain.anchors().size());
+  // Every output the file had comes out the same; the IoU channels follow them.
+  plain.net->eval();
+  extended->net->eval();
+  torch::NoGradGuard ng;
+  const auto x = torch::rand({1, 6, 128, 128});
+  const auto a = plain.forward(x), b = extended->forward(x);
+  for (const auto& [stride, out] : a.head) {
+    const auto& ext = b.head.at(stride);
+    EXPECT_EQ(ext.size(1), out.size(1) + out.size(1) / (1 + 3 + kBoxCodeSize));
+    EXPECT_TRUE(torch::equal(ext.narrow(1, 0, out.size(1)), out)) << "stride " << stride;
+  }
+  // The reverse (dropping outputs) and any other difference are refused, saying what differs.
+  const std::string with_path = dir / "with.ret3d";
+  extended->save(with_path);
+  EXPECT_THROW(nn::DetectorModel::extend(with_path, smallModel(HeadType::Anchor)), ModelFileError);
+  ModelConfig other = with;
+  other.network.head_channels = 16;
+  try {
+    nn::DetectorModel::extend(path, other);
+    FAIL() << "a model of another width was extended";
+  } catch (const ModelFileError& e) {
+    EXPECT_NE(std::string(e.what()).find("model.network.head_channels: 32 vs 16"), std::string::npos) << e.what();
+  }
 }
 
 TEST(ModelFile, TruncatedOrCorruptFilesAreRefused) {

@@ -46,5 +46,36 @@ TEST(RotatedNms, MaxKeepAndEmptyInput) {
   EXPECT_EQ(keep[1], 2u);
 }
 
+TEST(VoteBoxes, KeptBoxesBecomeTheScoreWeightedMeanOfTheirOverlappingCandidates) {
+  std::vector<Box> boxes = {box(0, 0, 0, 0.75f), box(0.4, 0.2, 0.1, 0.25f), box(10, 0, 0, 0.5f),
+                            box(0, 0, 0, 0.9f, ObjectClass::Cyclist, 1.8, 0.6)};
+  boxes[1].length = 4.0 * std::exp(0.4);  // log sizes are averaged
+  boxes[1].vx = 4.0;
+  const auto keep = rotatedNms(boxes, 0.1);
+  ASSERT_EQ(keep.size(), 3u);
+  const auto voted = voteBoxes(boxes, keep, 0.3);
+  ASSERT_EQ(voted.size(), 3u);
+  // keep: cyclist (0.9), car 0 (0.75), far car (0.5).
+  const Box& car = voted[1];
+  EXPECT_NEAR(car.x, 0.25 * 0.4, 1e-9);
+  EXPECT_NEAR(car.y, 0.25 * 0.2, 1e-9);
+  EXPECT_NEAR(car.yaw, 0.25 * 0.1, 1e-9);
+  EXPECT_NEAR(car.length, 4.0 * std::exp(0.25 * 0.4), 1e-9);
+  EXPECT_NEAR(car.vx, 1.0, 1e-9);
+  EXPECT_FLOAT_EQ(car.score, 0.75f);  // the score stays the kept box's
+  EXPECT_EQ(voted[0].x, 0.0);         // the cyclist overlaps the car but is of another class: untouched
+  EXPECT_EQ(voted[0].length, 1.8);
+  EXPECT_EQ(voted[2].x, 10.0);        // nothing overlaps the far car
+  // Below the voting IoU a candidate has no say.
+  EXPECT_EQ(voteBoxes(boxes, keep, 0.95)[1].x, 0.0);
+}
+
+TEST(VoteBoxes, AFlippedCandidateVotesForTheSameAxis) {
+  const std::vector<Box> boxes = {box(0, 0, 0.1, 0.5f), box(0, 0, 0.1 + M_PI, 0.5f)};
+  const auto voted = voteBoxes(boxes, {0}, 0.5);
+  ASSERT_EQ(voted.size(), 1u);
+  EXPECT_NEAR(voted[0].yaw, 0.1, 1e-9);  // not 0.1 + pi / 2
+}
+
 }  // namespace
 }  // namespace ret3d

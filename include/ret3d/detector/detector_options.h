@@ -37,6 +37,10 @@ struct AnchorHeadOptions {
   // longer side, else at the finest stride.
   double scale_fraction = 0.6;
   int neighbour_cells = 2;            // extra positive cells per object (YOLOv5: the two nearest neighbours)
+  // One more channel per anchor predicts the 3D IoU of its decoded box with the object (IoU-aware scoring, as in
+  // CIA-SSD and AFDetV2): at inference the score also ranks by how well the box fits, which is what AP at a strict
+  // IoU threshold (Car @0.7) rewards.
+  bool iou_quality = false;
 };
 
 struct CenterHeadOptions {
@@ -71,6 +75,11 @@ struct InferenceOptions {
   int max_candidates = 500;    // per class before NMS
   int max_detections = 200;    // after NMS
   double nms_iou = 0.1;        // rotated BEV IoU, per class
+  // Box voting after NMS: each kept box becomes the score-weighted mean of the candidates of its class that overlap
+  // it by at least this BEV IoU (itself included); neighbouring cells' predictions sharpen the box. 0 = off.
+  double nms_voting_iou = 0.0;
+  // With a model that predicts IoU (anchor.iou_quality): score = (objectness * class)^(1 - p) * IoU^p.
+  double iou_score_power = 0.5;
 };
 
 struct TrainOptions {
@@ -101,6 +110,7 @@ struct TrainOptions {
   double supervised_fov_deg = 0.0;
   double loss_weight_regression = 2.0;
   double loss_weight_velocity = 0.5;
+  double loss_weight_iou = 1.0;   // the IoU-quality channels (anchor.iou_quality)
 };
 
 struct DetectorOptions {

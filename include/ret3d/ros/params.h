@@ -65,7 +65,8 @@ struct PoseParams {
 
 struct DetectorNodeletParams {
   DetectorOptions detector;          // ~model_path with ~config (YAML file; empty: the config stored in the model
-                                     // file), then ~threads, ~score_threshold, ~nms_iou, ~max_detections
+                                     // file), then ~threads, ~score_threshold, ~nms_iou, ~nms_voting_iou,
+                                     // ~iou_score_power, ~max_detections
   CloudConversionOptions cloud;      // ~intensity_scaling (auto|datatype|observed_max|fixed), ~intensity_scale
   PoseParams pose;
   double max_sweep_gap = 0.25;       // s: an older previous sweep is not used (LWD-3D's second sweep is 0.1 s back)

@@ -27,6 +27,12 @@ class DetectorModel {
   // Loads a model file; when `expected` is given, refuses (ModelFileError) a file whose model config differs,
   // listing every difference.
   static std::unique_ptr<DetectorModel> load(const std::string& path, const ModelConfig* expected = nullptr);
+  // A model of `config` started from the weights of a model file whose config differs at most by outputs that
+  // `config` adds (anchor.iou_quality turned on): every tensor of the file is copied, a head layer that gained output
+  // channels gets the file's in its leading ones. `fresh` (optional) receives the names of tensors not (fully)
+  // copied. Throws ModelFileError for any other difference.
+  static std::unique_ptr<DetectorModel> extend(const std::string& path, const ModelConfig& config,
+                                               std::vector<std::string>* fresh = nullptr);
   // trained_with: the full config text of the run, stored for the record.
   void save(const std::string& path, const std::string& trained_with = "") const;
 

@@ -56,9 +56,9 @@ struct LwdNetworkImpl : torch::nn::Module {
   // head_channels_per_stride: the output channels of the head at each stride (they depend on the head type).
   LwdNetworkImpl(const NetworkOptions& options, int in_channels, const std::map<int, int>& head_channels_per_stride);
   NetworkOutput forward(const torch::Tensor& bev);
-  // Initialises the bias of the first `count` channels of the head at `stride` every `period` channels (focal-loss
-  // prior, RetinaNet: -log((1 - p) / p)).
-  void initClassificationBias(int stride, int first, int count, int period, double prior);
+  // Initialises the bias of the first `count` channels of the head at `stride` every `period` channels, among its
+  // first `end` channels (0 = all) (focal-loss prior, RetinaNet: -log((1 - p) / p)).
+  void initClassificationBias(int stride, int first, int count, int period, double prior, int end = 0);
 
   NetworkOptions options;
   ConvBnRelu stem{nullptr};
