@@ -6,6 +6,7 @@
 //   });
 #pragma once
 
+#include <iostream>
 #include <string>
 #include <vector>
 
@@ -49,6 +50,31 @@ struct RelationTrainArgs {
                   const std::string& config_help);
   // Throws std::runtime_error unless --data and --out are given with exactly one source of boxes.
   void validate() const;
+
+  // --inspect: prints a relation model file's metadata (`what`: "IntraRM", "InterRM"); Info has format_version,
+  // trained_on and a config that its namespace's toYaml prints.
+  template <class Info>
+  int printModelInfo(const std::string& what, const Info& info) const {
+    std::cout << what << " model " << inspect << "\nformat_version: " << info.format_version
+              << "\ntrained_on: " << info.trained_on << "\n"
+              << toYaml(info.config) << std::endl;  // found by ADL in the module's namespace
+    return 0;
+  }
+
+  // The trainer's options from these arguments: the module's config (`load` reads --config; default config
+  // without it), --epochs, output, checkpoint, resume, progress and the command line for the model file.
+  template <class Options, class LoadConfig>
+  Options trainOptions(LoadConfig load) const {
+    Options opt;
+    opt.config = config.empty() ? decltype(opt.config){} : load(config);
+    if (epochs >= 0) opt.config.train.epochs = epochs;
+    opt.out_path = out;
+    opt.checkpoint_dir = checkpoint;
+    opt.resume = resume;
+    opt.progress = !quiet;
+    opt.trained_on = command_line;
+    return opt;
+  }
 };
 
 }  // namespace tools

@@ -23,23 +23,10 @@ struct TrainInterArgs : RelationTrainArgs {
 };
 
 int runTrainInter(const TrainInterArgs& a) {
-  if (!a.inspect.empty()) {
-    const relation::InterRMModelInfo info = relation::readInterRMModelInfo(a.inspect);
-    std::cout << "InterRM model " << a.inspect << "\nformat_version: " << info.format_version
-              << "\ntrained_on: " << info.trained_on << "\n"
-              << relation::toYaml(info.config) << std::endl;
-    return 0;
-  }
+  if (!a.inspect.empty()) return a.printModelInfo("InterRM", relation::readInterRMModelInfo(a.inspect));
   a.validate();
   relation::setTorchThreads(a.threads);
-  train::InterTrainOptions opt;
-  opt.config = a.config.empty() ? relation::InterRMConfig{} : relation::loadInterRMConfig(a.config);
-  if (a.epochs >= 0) opt.config.train.epochs = a.epochs;
-  opt.out_path = a.out;
-  opt.checkpoint_dir = a.checkpoint;
-  opt.resume = a.resume;
-  opt.progress = !a.quiet;
-  opt.trained_on = a.command_line;
+  auto opt = a.trainOptions<train::InterTrainOptions>(relation::loadInterRMConfig);
 
   train::InterDataOptions data;
   data.data_dir = a.data;

@@ -18,23 +18,10 @@ namespace {
 using TrainIntraArgs = RelationTrainArgs;
 
 int runTrainIntra(const TrainIntraArgs& a) {
-  if (!a.inspect.empty()) {
-    const relation::IntraRMModelInfo info = relation::readIntraRMModelInfo(a.inspect);
-    std::cout << "IntraRM model " << a.inspect << "\nformat_version: " << info.format_version
-              << "\ntrained_on: " << info.trained_on << "\n"
-              << relation::toYaml(info.config) << std::endl;
-    return 0;
-  }
+  if (!a.inspect.empty()) return a.printModelInfo("IntraRM", relation::readIntraRMModelInfo(a.inspect));
   a.validate();
   relation::setTorchThreads(a.threads);
-  train::IntraTrainOptions opt;
-  opt.config = a.config.empty() ? relation::IntraRMConfig{} : relation::loadIntraRMConfig(a.config);
-  if (a.epochs >= 0) opt.config.train.epochs = a.epochs;
-  opt.out_path = a.out;
-  opt.checkpoint_dir = a.checkpoint;
-  opt.resume = a.resume;
-  opt.progress = !a.quiet;
-  opt.trained_on = a.command_line;
+  auto opt = a.trainOptions<train::IntraTrainOptions>(relation::loadIntraRMConfig);
 
   std::vector<relation::IntraRMFrame> train_frames, val_frames;
   if (a.detector.given()) {
