@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Chooses the detector's inference options on the validation set (never on the held-out test set): runs
-# `ret3d detect --stages base` then `ret3d eval` on data/sim_val_urban for every pair of box-voting IoU
+# Chooses the detector's inference options on a tuning set (never on the held-out test set): simulates it once
+# (urban, HDL-64E, 8 x 60 frames, seeds 5100-5107, used nowhere else), then runs `ret3d detect --stages base` and
+# `ret3d eval` on it for every pair of box-voting IoU
 # (inference.nms_voting_iou) and IoU-score power (inference.iou_score_power) below and prints the mean of the three
 # classes' 3D AP R40 moderate (the criterion scripts/train_default.sh selects models by), best last.
 #   scripts/tune_inference.sh MODEL CONFIG [VOTING_LIST] [POWER_LIST]
@@ -15,8 +16,12 @@ POWERS=${4:-0 0.3 0.5 0.7}
 set +u
 source scripts/env.sh
 set -u
-DATA=data/sim_val_urban
-[ -f "$DATA/.done" ] || { echo "no validation set at $DATA: run scripts/train_default.sh first" >&2; exit 1; }
+DATA=data/sim_tune_urban
+if [ ! -f "$DATA/.done" ]; then
+  rm -rf "$DATA"
+  ret3d sim --config config/sim/urban_street.yaml --out "$DATA" --sequences 8 --frames 60 --seed 5100 >/dev/null
+  touch "$DATA/.done"
+fi
 OUT=out/tune_inference
 mkdir -p "$OUT"
 : >"$OUT/results.txt"
