@@ -6,7 +6,9 @@
 #   3. runs each on the validation set (`ret3d detect` then `ret3d eval`) and keeps the better one (mean of the
 #      three classes' 3D AP R40 moderate);
 #   4. gives the better head the rest of the budget: a second stage (config/detector/lwd3d_<head>_stage2.yaml,
-#      12 more epochs from its weights, both threads), installed as models/lwd3d/detector.pt when it validates better.
+#      12 more epochs from its weights, both threads; the anchor head's adds IoU-quality channels, which start fresh),
+#      installed as models/lwd3d/detector.pt when it validates better. Its inference options (box voting, IoU-score
+#      power) were chosen once with scripts/tune_inference.sh and are written in that YAML.
 # Resumable: run it again after a stop and it continues from the last checkpoint (every 5 minutes); finished steps
 # are skipped. About 75-90 minutes on the idle 2-core machine for the two heads, then 30-45 minutes for the second
 # stage. Work goes to data/ and out/train_default/.
