@@ -26,12 +26,9 @@ stamp=$(md5sum "$MODELS/detector.pt" "$MODELS/intra_rm.pt" | cut -c1-32 | tr -d 
 if [ "$(cat "$OUT/models.md5" 2>/dev/null)" != "$stamp" ]; then rm -rf "$OUT" out/heldout/sim_inter_* out/heldout/sim_intra_track; fi
 mkdir -p "$OUT/configs"
 echo "$stamp" >"$OUT/models.md5"
+source scripts/simulate_once.sh
 DATA=data/sim_relation_urban
-if [ ! -f "$DATA/.done" ]; then
-  rm -rf "$DATA"
-  ret3d sim --config config/sim/urban_street.yaml --out "$DATA" --sequences 12 --frames 80 --seed 3000
-  touch "$DATA/.done"
-fi
+simulate_once "$DATA" config/sim/urban_street.yaml 12 80 3000
 
 NAMES=()
 for n in $HISTORIES; do

@@ -22,12 +22,9 @@ CONFIGS=("$@")
 if [ ${#CONFIGS[@]} -eq 0 ]; then
   CONFIGS=(intra_lwd3d intra_lwd3d_no_edge intra_lwd3d_r1 intra_lwd3d_r4 intra_lwd3d_m1 intra_lwd3d_m2 intra_lwd3d_m6)
 fi
+source scripts/simulate_once.sh
 DATA=data/sim_relation_urban
-if [ ! -f "$DATA/.done" ]; then
-  rm -rf "$DATA"
-  ret3d sim --config config/sim/urban_street.yaml --out "$DATA" --sequences 12 --frames 80 --seed 3000
-  touch "$DATA/.done"
-fi
+simulate_once "$DATA" config/sim/urban_street.yaml 12 80 3000
 
 train() {  # config
   [ -f "$OUT/$1.pt" ] && return

@@ -15,12 +15,9 @@ shift 2 || true
 set +u
 source scripts/env.sh
 set -u
+source scripts/simulate_once.sh
 DATA=data/sim_test_urban
-if [ ! -f "$DATA/.done" ]; then
-  rm -rf "$DATA"
-  ret3d sim --config config/sim/urban_street.yaml --out "$DATA" --sequences 5 --frames 100 --seed 9000
-  touch "$DATA/.done"
-fi
+simulate_once "$DATA" config/sim/urban_street.yaml 5 100 9000
 OUT=out/heldout/$NAME
 rm -rf "$OUT"
 mkdir -p "$OUT"

@@ -22,11 +22,9 @@ set -u
 OUT=out/train_default
 mkdir -p "$OUT" data models/lwd3d
 
+source scripts/simulate_once.sh
 simulate() {  # name config sequences frames seed
-  if [ -f "data/$1/.done" ]; then return; fi
-  rm -rf "data/$1"
-  ret3d sim --config "$2" --out "data/$1" --sequences "$3" --frames "$4" --seed "$5" >"$OUT/$1.log" 2>&1
-  touch "data/$1/.done"
+  simulate_once "data/$1" "$2" "$3" "$4" "$5" "$OUT/$1.log"
 }
 simulate sim_train_urban config/sim/urban_street.yaml 32 80 1000
 simulate sim_train_highway config/sim/highway.yaml 8 60 2000

@@ -16,12 +16,9 @@ POWERS=${4:-0 0.3 0.5 0.7}
 set +u
 source scripts/env.sh
 set -u
+source scripts/simulate_once.sh
 DATA=data/sim_tune_urban
-if [ ! -f "$DATA/.done" ]; then
-  rm -rf "$DATA"
-  ret3d sim --config config/sim/urban_street.yaml --out "$DATA" --sequences 8 --frames 60 --seed 5100 >/dev/null
-  touch "$DATA/.done"
-fi
+simulate_once "$DATA" config/sim/urban_street.yaml 8 60 5100 /dev/null
 OUT=out/tune_inference
 mkdir -p "$OUT"
 : >"$OUT/results.txt"
