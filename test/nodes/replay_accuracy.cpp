@@ -43,8 +43,10 @@ namespace fs = std::filesystem;
 // 2000-2007, 3000-3011), selection (5000-5001) or held-out (9000-9004) seeds, nor the demo's 777.
 constexpr int kFrames = 100;
 constexpr int kSeed = 4242;
-// Half real time: 5 scans a second leave the pipeline room to keep up on a busy 2-core CI machine.
-constexpr double kRate = 0.5;
+// A quarter of real time: 2.5 scans a second leave the pipeline room to keep up on a busy 2-core CI machine. This test
+// checks what the pipeline outputs, not its speed (`ret3d bench` measures that): at half real time a fresh-clone run
+// dropped 3 of 100 scans while the hypervisor took 20-26 % of the CPU and the detector ran 4-6 times slower than idle.
+constexpr double kRate = 0.25;
 // Mean 3D AP R40 moderate over the three classes (KITTI devkit rules, front camera view; the figure the model card
 // selects heads by). The default models of models/lwd3d (session 4: 24-epoch detector with IoU channels and box
 // voting, IntraRM m 1, InterRM N 30) score 61.5 on this drive (Car 46.2, Pedestrian 66.2, Cyclist 71.9); the
