@@ -183,14 +183,16 @@ class AnchorHead : public DetectionHead {
       positives += P;
       if (P == 0) continue;
       auto opt = torch::TensorOptions().dtype(torch::kLong);
-      auto sel = r.index({torch::tensor(idx_n, opt), torch::tensor(idx_a, opt), torch::tensor(idx_v, opt),
-                          torch::tensor(idx_u, opt)});  // P x D
+      // The positives' (n, a, v, u), indexing the box channels and, with quality, the IoU channels.
+      const std::vector<torch::Tensor> at = {torch::tensor(idx_n, opt), torch::tensor(idx_a, opt),
+                                             torch::tensor(idx_v, opt), torch::tensor(idx_u, opt)};
+      auto sel = r.index({at[0], at[1], at[2], at[3]});  // P x D
       cls_sum = cls_sum + F::cross_entropy(sel.index({Slice(), Slice(1, 1 + C_)}), torch::tensor(cls, opt),
                                            F::CrossEntropyFuncOptions().reduction(torch::kSum));
       auto reg = sel.index({Slice(), Slice(1 + C_, D_)});
       // The centre offset is 2 sigmoid - 0.5 (YOLOv5), the rest raw.
       reg = torch::cat({2 * torch::sigmoid(reg.index({Slice(), Slice(0, 2)})) - 0.5, reg.index({Slice(), Slice(2, kBoxCodeSize)})}, 1);
-      if (quality_) iou_sum = iou_sum + qualityLoss(raw, A, reg, idx_n, idx_a, idx_v, idx_u, pos_box, anchors, stride, g);
+      if (quality_) iou_sum = iou_sum + qualityLoss(raw, A, reg, at, idx_a, idx_v, idx_u, pos_box, anchors, stride, g);
       preds.push_back(reg);
       targets.push_back(torch::from_blob(codes.data(), {P, kBoxCodeSize}).clone());
       valids.push_back(torch::tensor(vvalid));
@@ -224,7 +226,7 @@ class AnchorHead : public DetectionHead {
       auto r = raw.narrow(0, 0, A * D_).reshape({A, D_, h, w});
       auto score = torch::sigmoid(r.index({Slice(), Slice(0, 1)})) *
                    torch::softmax(r.index({Slice(), Slice(1, 1 + C_)}), 1);  // A x C x h x w
-      if (quality_) {
+      if (quality_ && o.iou_score_power > 0) {
         const double p = o.iou_score_power;
         auto iou = torch::sigmoid(raw.narrow(0, A * D_, A)).unsqueeze(1);  // A x 1 x h x w
         score = score.pow(1 - p) * iou.pow(p);
@@ -258,11 +260,13 @@ class AnchorHead : public DetectionHead {
  private:
   // BCE between the IoU channel at each positive and the 3D IoU of the box decoded there (prediction detached: the
   // channel learns to judge the box, not to move it) with its object.
-  torch::Tensor qualityLoss(const torch::Tensor& raw, int A, const torch::Tensor& reg, const std::vector<int64_t>& idx_n,
-                            const std::vector<int64_t>& idx_a, const std::vector<int64_t>& idx_v,
+  // at: the positives' (n, a, v, u) index tensors; idx_*: the same indices on the host.
+  torch::Tensor qualityLoss(const torch::Tensor& raw, int A, const torch::Tensor& reg,
+                            const std::vector<torch::Tensor>& at, const std::vector<int64_t>& idx_a,
+                            const std::vector<int64_t>& idx_v,
                             const std::vector<int64_t>& idx_u, const std::vector<const Box*>& objects,
                             const std::vector<Anchor>& anchors, int stride, const BevGeometry& g) const {
-    const int64_t P = static_cast<int64_t>(idx_n.size());
+    const int64_t P = static_cast<int64_t>(idx_a.size());
     auto codes = reg.detach().contiguous();
     auto ca = codes.accessor<float, 2>();
     std::vector<float> target(P);
@@ -273,9 +277,7 @@ class AnchorHead : public DetectionHead {
                                     stride, g, config_.sweep_interval);
       target[i] = static_cast<float>(iou3d(b, *objects[i]));
     }
-    auto opt = torch::TensorOptions().dtype(torch::kLong);
-    auto q = raw.narrow(1, A * D_, A).index({torch::tensor(idx_n, opt), torch::tensor(idx_a, opt),
-                                             torch::tensor(idx_v, opt), torch::tensor(idx_u, opt)});
+    auto q = raw.narrow(1, A * D_, A).index({at[0], at[1], at[2], at[3]});
     return F::binary_cross_entropy_with_logits(q, torch::tensor(target),
                                                F::BinaryCrossEntropyWithLogitsFuncOptions().reduction(torch::kSum));
   }
