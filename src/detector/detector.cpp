@@ -81,6 +81,10 @@ Detections Detector::detect(const PointCloud& current, const PointCloud* previou
   }
   timings_.nms_ms = msSince(t0);
 
+  t0 = std::chrono::steady_clock::now();
+  if (options_.inference.point_refine.enabled()) refineBoxesFromPoints(current, &det.boxes, options_.inference.point_refine);
+  timings_.refine_ms = msSince(t0);
+
   // The features o_i belong to decoding (Ret3D §3.1): timed with it.
   t0 = std::chrono::steady_clock::now();
   const auto f = nn::sampleFeatures(out.features[0], det.boxes, g, options_.model.featureStride());

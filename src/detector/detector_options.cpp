@@ -99,16 +99,21 @@ class MapReader {
   std::set<std::string> known_;
 };
 
-void readModel(MapReader r, ModelConfig* m) {
-  std::vector<std::string> classes;
-  for (ObjectClass c : m->classes) classes.push_back(className(c));
-  r.get("classes", &classes);
-  m->classes.clear();
-  for (const auto& name : classes) {
-    auto c = classFromName(name);
+// A list of class names under `classes`, e.g. [Car, Pedestrian].
+void readClasses(MapReader& r, std::vector<ObjectClass>* out) {
+  std::vector<std::string> names;
+  for (ObjectClass c : *out) names.push_back(className(c));
+  r.get("classes", &names);
+  out->clear();
+  for (const auto& name : names) {
+    const auto c = classFromName(name);
     if (!c) r.fail(r.full("classes"), "unknown class '" + name + "' (Car, Pedestrian, Cyclist)");
-    m->classes.push_back(*c);
+    out->push_back(*c);
   }
+}
+
+void readModel(MapReader r, ModelConfig* m) {
+  readClasses(r, &m->classes);
   {
     MapReader g = r.child("bev");
     g.get("x_min", &m->geometry.x_min);
@@ -166,6 +171,23 @@ void readInference(MapReader r, InferenceOptions* o) {
   r.get("nms_iou", &o->nms_iou);
   r.get("nms_voting_iou", &o->nms_voting_iou);
   r.get("iou_score_power", &o->iou_score_power);
+  {
+    MapReader p = r.child("point_refine");
+    readClasses(p, &o->point_refine.classes);
+    p.get("quantile", &o->point_refine.quantile);
+    p.get("surface_gap", &o->point_refine.surface_gap);
+    p.get("margin", &o->point_refine.margin);
+    p.get("ground_clearance", &o->point_refine.ground_clearance);
+    p.get("max_shift", &o->point_refine.max_shift);
+    p.get("min_points", &o->point_refine.min_points);
+    p.get("height", &o->point_refine.height);
+    p.finish();
+    try {
+      o->point_refine.validate();
+    } catch (const std::invalid_argument& e) {
+      r.fail(r.full("point_refine"), e.what());
+    }
+  }
   r.finish();
   if (!(o->iou_score_power >= 0 && o->iou_score_power <= 1)) r.fail(r.full("iou_score_power"), "must lie in [0, 1]");
   if (!(o->nms_voting_iou >= 0 && o->nms_voting_iou <= 1)) r.fail(r.full("nms_voting_iou"), "must lie in [0, 1]");

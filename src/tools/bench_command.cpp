@@ -284,14 +284,14 @@ int runBench(BenchArgs a) {
   std::ostringstream json;
   json << "{";
   bool first = true;
-  for (const char* stage : {"bev", "network", "decode", "nms", "intra", "track", "inter", "total"})
+  for (const char* stage : {"bev", "network", "decode", "nms", "refine", "intra", "track", "inter", "total"})
     if (t.count(stage)) printRow(stage, summarise(t.at(stage)), &json, &first);
-  // The base detector alone (BEV + network + decoding + NMS), the figure of the latency budget.
+  // The base detector alone (BEV + network + decoding + NMS + point refinement), the figure of the latency budget.
   std::vector<double> base;
   for (std::size_t i = 0; i < t.at("bev").size(); ++i)
-    base.push_back(t.at("bev")[i] + t.at("network")[i] + t.at("decode")[i] + t.at("nms")[i]);
+    base.push_back(t.at("bev")[i] + t.at("network")[i] + t.at("decode")[i] + t.at("nms")[i] + t.at("refine")[i]);
   printRow("base", summarise(base), &json, &first);
-  std::cout << "(base = bev + network + decode + nms)\n";
+  std::cout << "(base = bev + network + decode + nms + refine)\n";
   const Detector* det = p.detector();
   const std::string model = det->options().inference.model_path;
   std::cout << "detector: " << det->parameterCount() << " parameters, model file " << fs::file_size(model)

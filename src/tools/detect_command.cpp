@@ -235,7 +235,7 @@ int runDetect(DetectArgs a) {
   const auto& t = p.times().all();
   const std::size_t frames = t.count("total") ? t.at("total").size() : 0;
   std::cout << "detect: " << frames << " frames, " << boxes << " boxes written to " << a.out;
-  for (const char* stage : {"bev", "network", "decode", "nms", "intra", "track", "inter", "total"})
+  for (const char* stage : {"bev", "network", "decode", "nms", "refine", "intra", "track", "inter", "total"})
     if (t.count(stage)) std::cout << "; " << stage << " " << median(t.at(stage)) << " ms";
   std::cout << " (medians per frame; `ret3d bench` for timings)" << std::endl;
   return 0;

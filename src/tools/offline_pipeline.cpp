@@ -118,6 +118,7 @@ Detections OfflinePipeline::run(const PointCloud* current, const PointCloud* pre
     times_.add("network", t.network_ms);
     times_.add("decode", t.decode_ms);
     times_.add("nms", t.nms_ms);
+    times_.add("refine", t.refine_ms);
     total += t.total();
   }
   if (intra_) {

@@ -21,8 +21,8 @@ class DetectorModel;
 
 // Wall time of each part of the last detect() call, milliseconds.
 struct DetectorTimings {
-  double bev_ms = 0, network_ms = 0, decode_ms = 0, nms_ms = 0;
-  double total() const { return bev_ms + network_ms + decode_ms + nms_ms; }
+  double bev_ms = 0, network_ms = 0, decode_ms = 0, nms_ms = 0, refine_ms = 0;
+  double total() const { return bev_ms + network_ms + decode_ms + nms_ms + refine_ms; }
 };
 
 class Detector {

@@ -8,6 +8,7 @@
 
 #include "ret3d/bev/bev_encoder.h"
 #include "ret3d/core/types.h"
+#include "ret3d/detector/point_refine.h"
 
 namespace ret3d {
 
@@ -80,6 +81,8 @@ struct InferenceOptions {
   double nms_voting_iou = 0.0;
   // With a model that predicts IoU (anchor.iou_quality): score = (objectness * class)^(1 - p) * IoU^p.
   double iou_score_power = 0.5;
+  // Box refinement from the raw returns after NMS (point_refine.h); off unless classes are listed.
+  PointRefineOptions point_refine;
 };
 
 struct TrainOptions {

@@ -1,0 +1,134 @@
+#include "ret3d/detector/point_refine.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace ret3d {
+
+void PointRefineOptions::validate() const {
+  auto fail = [](const std::string& field, const std::string& what) {
+    throw std::invalid_argument("point_refine." + field + " " + what);
+  };
+  for (ObjectClass c : classes)
+    if (c == ObjectClass::Unknown) fail("classes", "must name Car, Pedestrian or Cyclist");
+  if (!(quantile > 0 && quantile <= 1)) fail("quantile", "must lie in (0, 1]");
+  if (!(surface_gap >= 0 && surface_gap < 1)) fail("surface_gap", "must lie in [0, 1) m");
+  if (!(margin >= 0 && margin < 5)) fail("margin", "must lie in [0, 5) m");
+  if (!(ground_clearance >= 0 && ground_clearance < 5)) fail("ground_clearance", "must lie in [0, 5) m");
+  if (!(max_shift >= 0 && max_shift < 5)) fail("max_shift", "must lie in [0, 5) m");
+  if (min_points < 1) fail("min_points", "must be >= 1");
+}
+
+namespace {
+
+// The returns binned in square cells over the area the boxes cover (a counting sort), so that each box visits
+// only the returns near it.
+class CellIndex {
+ public:
+  CellIndex(const PointCloud& cloud, double x0, double y0, double x1, double y1, double cell)
+      : x0_(x0), y0_(y0), cell_(cell) {
+    nx_ = std::max(1, static_cast<int>(std::ceil((x1 - x0) / cell)));
+    ny_ = std::max(1, static_cast<int>(std::ceil((y1 - y0) / cell)));
+    start_.assign(static_cast<std::size_t>(nx_) * ny_ + 1, 0);
+    std::vector<int> cell_of(cloud.size(), -1);
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+      const Point& p = cloud.points[i];
+      const int cx = cellX(p.x), cy = cellY(p.y);
+      if (cx < 0 || cy < 0 || cx >= nx_ || cy >= ny_ || !std::isfinite(p.z)) continue;
+      cell_of[i] = cy * nx_ + cx;
+      ++start_[static_cast<std::size_t>(cell_of[i]) + 1];
+    }
+    for (std::size_t c = 1; c < start_.size(); ++c) start_[c] += start_[c - 1];
+    order_.resize(start_.back());
+    std::vector<std::size_t> fill(start_.begin(), start_.end() - 1);
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+      if (cell_of[i] >= 0) order_[fill[static_cast<std::size_t>(cell_of[i])]++] = i;
+  }
+
+  // Calls f(point index) for the returns in the cells overlapping [x - r, x + r] x [y - r, y + r].
+  template <typename F>
+  void visit(double x, double y, double r, F&& f) const {
+    const int cx0 = std::max(0, cellX(x - r)), cx1 = std::min(nx_ - 1, cellX(x + r));
+    const int cy0 = std::max(0, cellY(y - r)), cy1 = std::min(ny_ - 1, cellY(y + r));
+    for (int cy = cy0; cy <= cy1; ++cy)
+      for (int cx = cx0; cx <= cx1; ++cx) {
+        const std::size_t c = static_cast<std::size_t>(cy) * nx_ + cx;
+        for (std::size_t k = start_[c]; k < start_[c + 1]; ++k) f(order_[k]);
+      }
+  }
+
+ private:
+  int cellX(double x) const { return static_cast<int>(std::floor((x - x0_) / cell_)); }
+  int cellY(double y) const { return static_cast<int>(std::floor((y - y0_) / cell_)); }
+  double x0_, y0_, cell_;
+  int nx_ = 1, ny_ = 1;
+  std::vector<std::size_t> start_, order_;
+};
+
+double quantileOf(std::vector<double>* v, double q) {
+  const auto k = static_cast<std::ptrdiff_t>(std::floor(q * static_cast<double>(v->size() - 1)));
+  std::nth_element(v->begin(), v->begin() + k, v->end());
+  return (*v)[static_cast<std::size_t>(k)];
+}
+
+}  // namespace
+
+std::size_t refineBoxesFromPoints(const PointCloud& cloud, std::vector<Box>* boxes, const PointRefineOptions& o) {
+  auto refined = [&](const Box& b) {
+    return std::find(o.classes.begin(), o.classes.end(), b.label) != o.classes.end() && b.length > 0 &&
+           b.width > 0 && b.height > 0 && std::isfinite(b.x) && std::isfinite(b.y) && std::isfinite(b.yaw);
+  };
+  double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
+  for (const Box& b : *boxes) {
+    if (!refined(b)) continue;
+    const double r = 0.5 * std::hypot(b.length, b.width) + o.margin;
+    x0 = std::min(x0, b.x - r), y0 = std::min(y0, b.y - r);
+    x1 = std::max(x1, b.x + r), y1 = std::max(y1, b.y + r);
+  }
+  if (x0 > x1 || cloud.empty()) return 0;
+  const CellIndex index(cloud, x0, y0, x1 + 1e-6, y1 + 1e-6, 1.0);
+
+  std::size_t changed = 0;
+  std::vector<double> us, vs, zs;
+  for (Box& b : *boxes) {
+    if (!refined(b)) continue;
+    const double c = std::cos(b.yaw), s = std::sin(b.yaw);
+    const double hl = 0.5 * b.length + o.margin, hw = 0.5 * b.width + o.margin;
+    const double z_lo = b.bottom() + o.ground_clearance, z_hi = b.top() + 2 * o.margin;
+    us.clear(), vs.clear(), zs.clear();
+    index.visit(b.x, b.y, std::hypot(hl, hw), [&](std::size_t i) {
+      const Point& p = cloud.points[i];
+      if (!(p.z > z_lo && p.z < z_hi)) return;
+      const double dx = p.x - b.x, dy = p.y - b.y;
+      const double u = dx * c + dy * s, v = -dx * s + dy * c;
+      if (std::abs(u) >= hl || std::abs(v) >= hw) return;
+      us.push_back(u), vs.push_back(v), zs.push_back(p.z);
+    });
+    if (static_cast<int>(us.size()) < o.min_points) continue;
+
+    // The sensor (the origin) in the box frame: a face is visible when the sensor lies beyond it.
+    const double u_sensor = -(b.x * c + b.y * s), v_sensor = b.x * s - b.y * c;
+    auto shift = [&](std::vector<double>* coord, double sensor, double half_size) {
+      if (std::abs(sensor) <= half_size) return 0.0;
+      const double sign = sensor > 0 ? 1.0 : -1.0;
+      for (double& x : *coord) x *= sign;
+      const double face = quantileOf(coord, o.quantile);
+      return std::clamp(sign * (face + o.surface_gap - half_size), -o.max_shift, o.max_shift);
+    };
+    const double du = shift(&us, u_sensor, 0.5 * b.length), dv = shift(&vs, v_sensor, 0.5 * b.width);
+    b.x += du * c - dv * s;
+    b.y += du * s + dv * c;
+    if (o.height) {
+      const double bottom = b.bottom();
+      const double top = quantileOf(&zs, 0.995) + o.surface_gap;
+      b.height = std::clamp(top - bottom, 0.5 * b.height, 1.5 * b.height);
+      b.z = bottom + 0.5 * b.height;
+    }
+    ++changed;
+  }
+  return changed;
+}
+
+}  // namespace ret3d

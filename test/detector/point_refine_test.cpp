@@ -1,0 +1,181 @@
+#include "ret3d/detector/point_refine.h"
+
+#include <cmath>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "ret3d/detector/detector_options.h"
+
+namespace ret3d {
+namespace {
+
+Box carBox(double x, double y, double yaw, double l = 4.4, double w = 1.8, double h = 1.5) {
+  Box b;
+  b.x = x, b.y = y, b.z = -1.73 + 0.5 * h, b.yaw = yaw, b.length = l, b.width = w, b.height = h;
+  b.label = ObjectClass::Car;
+  b.score = 0.9f;
+  return b;
+}
+
+// Returns on the faces of `b` (as a box shrunk by `gap` on every side) that the sensor at the origin sees: a face is
+// visible when the sensor lies beyond its plane. Returns 5 cm apart, in rows
+// about 10 cm apart from 0.4 m above the bottom to the top.
+PointCloud visibleFaces(const Box& b, double gap = 0.05) {
+  PointCloud cloud;
+  const double c = std::cos(b.yaw), s = std::sin(b.yaw);
+  const double hl = 0.5 * b.length - gap, hw = 0.5 * b.width - gap, top = b.top() - gap;
+  const double u_sensor = -(b.x * c + b.y * s), v_sensor = b.x * s - b.y * c;
+  auto add = [&](double u, double v, double z) {
+    Point p;
+    p.x = static_cast<float>(b.x + u * c - v * s), p.y = static_cast<float>(b.y + u * s + v * c);
+    p.z = static_cast<float>(z), p.intensity = 0.3f;
+    cloud.push_back(p);
+  };
+  const int rows = static_cast<int>(std::ceil((top - b.bottom() - 0.4) / 0.1));
+  for (int k = 0; k <= rows; ++k) {
+    const double z = b.bottom() + 0.4 + (top - b.bottom() - 0.4) * k / rows;
+    if (std::abs(u_sensor) > hl)
+      for (double v = -hw; v <= hw + 1e-9; v += 0.05) add(u_sensor > 0 ? hl : -hl, v, z);
+    if (std::abs(v_sensor) > hw)
+      for (double u = -hl; u <= hl + 1e-9; u += 0.05) add(u, v_sensor > 0 ? hw : -hw, z);
+  }
+  return cloud;
+}
+
+// The box moved by (du, dv) along its own axes.
+Box moved(Box b, double du, double dv) {
+  b.x += du * std::cos(b.yaw) - dv * std::sin(b.yaw);
+  b.y += du * std::sin(b.yaw) + dv * std::cos(b.yaw);
+  return b;
+}
+
+PointRefineOptions carsOnly() {
+  PointRefineOptions o;
+  o.classes = {ObjectClass::Car};
+  o.quantile = 1.0;  // clean synthetic faces: the outermost return is the face
+  return o;
+}
+
+TEST(PointRefine, MovesTheBoxOntoTheVisibleFaces) {
+  // Seen obliquely (from behind and the right): the rear and the right side fix both axes.
+  const Box truth = carBox(12, 6, 0.3);
+  const PointCloud cloud = visibleFaces(truth);
+  std::vector<Box> boxes = {moved(truth, 0.35, -0.25)};
+  EXPECT_EQ(refineBoxesFromPoints(cloud, &boxes, carsOnly()), 1u);
+  EXPECT_NEAR(boxes[0].x, truth.x, 0.01);
+  EXPECT_NEAR(boxes[0].y, truth.y, 0.01);
+  EXPECT_DOUBLE_EQ(boxes[0].yaw, truth.yaw);
+  EXPECT_DOUBLE_EQ(boxes[0].length, truth.length);
+  EXPECT_DOUBLE_EQ(boxes[0].width, truth.width);
+}
+
+TEST(PointRefine, AHiddenFaceKeepsTheNetworksEstimate) {
+  // Straight ahead, seen end-on: the rear fixes the position along the car; across it, the sensor is within the
+  // car's width, so no side is seen and the lateral error stays.
+  const Box truth = carBox(15, 0, 0);
+  const PointCloud cloud = visibleFaces(truth);
+  std::vector<Box> boxes = {moved(truth, -0.3, 0.2)};
+  refineBoxesFromPoints(cloud, &boxes, carsOnly());
+  EXPECT_NEAR(boxes[0].x, truth.x, 0.01);
+  EXPECT_NEAR(boxes[0].y, truth.y + 0.2, 1e-9);
+}
+
+TEST(PointRefine, SetsTheTopFromTheHighestReturnsAndKeepsTheBottom) {
+  const Box truth = carBox(8, -7, -1.2, 4.0, 1.7, 1.62);
+  PointCloud cloud = visibleFaces(truth);
+  // Ground returns inside the footprint are below the clearance and must not count.
+  for (double u = -2; u <= 2; u += 0.1) {
+    Point p;
+    p.x = static_cast<float>(truth.x + u), p.y = static_cast<float>(truth.y), p.z = -1.73f;
+    cloud.push_back(p);
+  }
+  Box guess = truth;
+  guess.height = 1.35;
+  guess.z = truth.bottom() + 0.5 * guess.height;
+  std::vector<Box> boxes = {guess};
+  refineBoxesFromPoints(cloud, &boxes, carsOnly());
+  EXPECT_NEAR(boxes[0].height, truth.height, 0.01);
+  EXPECT_NEAR(boxes[0].bottom(), truth.bottom(), 1e-9);
+
+  PointRefineOptions no_height = carsOnly();
+  no_height.height = false;
+  boxes = {guess};
+  refineBoxesFromPoints(cloud, &boxes, no_height);
+  EXPECT_DOUBLE_EQ(boxes[0].height, guess.height);
+}
+
+TEST(PointRefine, LeavesOtherClassesSparseObjectsAndFarMovesAlone) {
+  const Box truth = carBox(10, 4, 0.1);
+  const PointCloud cloud = visibleFaces(truth);
+  Box cyclist = moved(truth, 0.3, 0.3);
+  cyclist.label = ObjectClass::Cyclist;
+  std::vector<Box> boxes = {cyclist};
+  EXPECT_EQ(refineBoxesFromPoints(cloud, &boxes, carsOnly()), 0u);
+  EXPECT_DOUBLE_EQ(boxes[0].x, cyclist.x);
+
+  // Two returns only: below min_points.
+  PointCloud sparse;
+  sparse.points.assign(cloud.points.begin(), cloud.points.begin() + 2);
+  boxes = {moved(truth, 0.3, 0.3)};
+  EXPECT_EQ(refineBoxesFromPoints(sparse, &boxes, carsOnly()), 0u);
+  EXPECT_DOUBLE_EQ(boxes[0].x, moved(truth, 0.3, 0.3).x);
+
+  // The move along each axis is clamped to max_shift.
+  PointRefineOptions o = carsOnly();
+  o.max_shift = 0.1;
+  const Box guess = moved(truth, 0.25, 0);
+  boxes = {guess};
+  refineBoxesFromPoints(cloud, &boxes, o);
+  EXPECT_NEAR(std::hypot(boxes[0].x - guess.x, boxes[0].y - guess.y), 0.1, 1e-6);
+
+  // Off by default; an empty cloud or NaN returns change nothing and do not throw.
+  boxes = {guess};
+  EXPECT_EQ(refineBoxesFromPoints(cloud, &boxes, PointRefineOptions()), 0u);
+  EXPECT_EQ(refineBoxesFromPoints(PointCloud(), &boxes, carsOnly()), 0u);
+  PointCloud nans;
+  Point p;
+  p.x = p.y = p.z = std::nanf("");
+  nans.points.assign(10, p);
+  EXPECT_EQ(refineBoxesFromPoints(nans, &boxes, carsOnly()), 0u);
+  EXPECT_DOUBLE_EQ(boxes[0].x, guess.x);
+}
+
+TEST(PointRefine, StrayReturnsAreOutvotedByTheQuantile) {
+  const Box truth = carBox(9, 9, 0.7);
+  PointCloud cloud = visibleFaces(truth);
+  // A few returns of a pole just outside the right side of the box (within the margin).
+  const double c = std::cos(truth.yaw), s = std::sin(truth.yaw);
+  for (int k = 0; k < 6; ++k) {
+    Point p;
+    p.x = static_cast<float>(truth.x + 0.5 * c + (0.5 * truth.width + 0.2) * s);
+    p.y = static_cast<float>(truth.y + 0.5 * s - (0.5 * truth.width + 0.2) * c);
+    p.z = static_cast<float>(truth.bottom() + 0.5 + 0.1 * k);
+    cloud.push_back(p);
+  }
+  PointRefineOptions o = carsOnly();
+  o.quantile = 0.9;
+  std::vector<Box> boxes = {truth};
+  refineBoxesFromPoints(cloud, &boxes, o);
+  EXPECT_LT(std::hypot(boxes[0].x - truth.x, boxes[0].y - truth.y), 0.03);
+}
+
+TEST(PointRefine, OptionsAreReadFromYamlAndMistakesRefused) {
+  const auto o = detectorOptionsFromYaml("inference:\n  point_refine: {classes: [Car, Cyclist], quantile: 0.8}\n");
+  ASSERT_EQ(o.inference.point_refine.classes.size(), 2u);
+  EXPECT_EQ(o.inference.point_refine.classes[1], ObjectClass::Cyclist);
+  EXPECT_DOUBLE_EQ(o.inference.point_refine.quantile, 0.8);
+  EXPECT_FALSE(detectorOptionsFromYaml("inference: {}").inference.point_refine.enabled());
+  for (const std::string bad : {"classes: [Truck]", "quantile: 0", "quantile: 1.5", "min_points: 0", "margn: 0.3",
+                                "max_shift: -1"}) {
+    try {
+      detectorOptionsFromYaml("inference:\n  point_refine: {" + bad + "}\n");
+      FAIL() << bad << " was accepted";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("inference.point_refine"), std::string::npos) << e.what();
+    }
+  }
+}
+
+}  // namespace
+}  // namespace ret3d
