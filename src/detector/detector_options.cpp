@@ -99,21 +99,21 @@ class MapReader {
   std::set<std::string> known_;
 };
 
-// A list of class names under `classes`, e.g. [Car, Pedestrian].
-void readClasses(MapReader& r, std::vector<ObjectClass>* out) {
+// A list of class names under `key`, e.g. classes: [Car, Pedestrian].
+void readClasses(MapReader& r, const std::string& key, std::vector<ObjectClass>* out) {
   std::vector<std::string> names;
   for (ObjectClass c : *out) names.push_back(className(c));
-  r.get("classes", &names);
+  r.get(key, &names);
   out->clear();
   for (const auto& name : names) {
     const auto c = classFromName(name);
-    if (!c) r.fail(r.full("classes"), "unknown class '" + name + "' (Car, Pedestrian, Cyclist)");
+    if (!c) r.fail(r.full(key), "unknown class '" + name + "' (Car, Pedestrian, Cyclist)");
     out->push_back(*c);
   }
 }
 
 void readModel(MapReader r, ModelConfig* m) {
-  readClasses(r, &m->classes);
+  readClasses(r, "classes", &m->classes);
   {
     MapReader g = r.child("bev");
     g.get("x_min", &m->geometry.x_min);
@@ -173,7 +173,17 @@ void readInference(MapReader r, InferenceOptions* o) {
   r.get("iou_score_power", &o->iou_score_power);
   {
     MapReader p = r.child("point_refine");
-    readClasses(p, &o->point_refine.classes);
+    readClasses(p, "faces", &o->point_refine.faces);
+    std::map<std::string, double> centroid;
+    for (const auto& [c, offset] : o->point_refine.centroid) centroid[className(c)] = offset;
+    p.get("centroid", &centroid);
+    o->point_refine.centroid.clear();
+    for (const auto& [name, offset] : centroid) {
+      const auto c = classFromName(name);
+      if (!c) p.fail(p.full("centroid"), "unknown class '" + name + "' (Car, Pedestrian, Cyclist)");
+      o->point_refine.centroid.emplace_back(*c, offset);
+    }
+    p.get("centroid_margin", &o->point_refine.centroid_margin);
     p.get("quantile", &o->point_refine.quantile);
     p.get("surface_gap", &o->point_refine.surface_gap);
     p.get("margin", &o->point_refine.margin);

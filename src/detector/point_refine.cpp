@@ -11,8 +11,15 @@ void PointRefineOptions::validate() const {
   auto fail = [](const std::string& field, const std::string& what) {
     throw std::invalid_argument("point_refine." + field + " " + what);
   };
-  for (ObjectClass c : classes)
-    if (c == ObjectClass::Unknown) fail("classes", "must name Car, Pedestrian or Cyclist");
+  for (ObjectClass c : faces)
+    if (c == ObjectClass::Unknown) fail("faces", "must name Car, Pedestrian or Cyclist");
+  for (const auto& [c, offset] : centroid) {
+    if (c == ObjectClass::Unknown) fail("centroid", "must name Car, Pedestrian or Cyclist");
+    if (!(std::abs(offset) < 2)) fail("centroid", "offsets must lie in (-2, 2) m");
+    if (std::find(faces.begin(), faces.end(), c) != faces.end())
+      fail("centroid", std::string("lists ") + className(c) + ", which faces refines already");
+  }
+  if (!(centroid_margin >= 0 && centroid_margin < 5)) fail("centroid_margin", "must lie in [0, 5) m");
   if (!(quantile > 0 && quantile <= 1)) fail("quantile", "must lie in (0, 1]");
   if (!(surface_gap >= 0 && surface_gap < 1)) fail("surface_gap", "must lie in [0, 1) m");
   if (!(margin >= 0 && margin < 5)) fail("margin", "must lie in [0, 5) m");
@@ -73,17 +80,95 @@ double quantileOf(std::vector<double>* v, double q) {
   return (*v)[static_cast<std::size_t>(k)];
 }
 
+// The returns of `b` (its footprint grown by `margin`, from ground_clearance above its bottom to z_top) in the box
+// frame: u along the heading, v across, and z.
+struct BoxReturns {
+  std::vector<double> u, v, z;
+  void collect(const PointCloud& cloud, const CellIndex& index, const Box& b, double margin, double clearance,
+               double z_top) {
+    u.clear(), v.clear(), z.clear();
+    const double c = std::cos(b.yaw), s = std::sin(b.yaw);
+    const double hl = 0.5 * b.length + margin, hw = 0.5 * b.width + margin;
+    const double z_lo = b.bottom() + clearance;
+    index.visit(b.x, b.y, std::hypot(hl, hw), [&](std::size_t i) {
+      const Point& p = cloud.points[i];
+      if (!(p.z > z_lo && p.z < z_top)) return;
+      const double dx = p.x - b.x, dy = p.y - b.y;
+      const double pu = dx * c + dy * s, pv = -dx * s + dy * c;
+      if (std::abs(pu) >= hl || std::abs(pv) >= hw) return;
+      u.push_back(pu), v.push_back(pv), z.push_back(p.z);
+    });
+  }
+};
+
+bool refineFaces(const PointCloud& cloud, const CellIndex& index, const PointRefineOptions& o, BoxReturns* r,
+                 Box* b) {
+  r->collect(cloud, index, *b, o.margin, o.ground_clearance, b->top() + 2 * o.margin);
+  if (static_cast<int>(r->u.size()) < o.min_points) return false;
+  const double c = std::cos(b->yaw), s = std::sin(b->yaw);
+  // The sensor (the origin) in the box frame: a face is visible when the sensor lies beyond it.
+  const double u_sensor = -(b->x * c + b->y * s), v_sensor = b->x * s - b->y * c;
+  auto shift = [&](std::vector<double>* coord, double sensor, double half_size) {
+    if (std::abs(sensor) <= half_size) return 0.0;
+    const double sign = sensor > 0 ? 1.0 : -1.0;
+    for (double& x : *coord) x *= sign;
+    const double face = quantileOf(coord, o.quantile);
+    return std::clamp(sign * (face + o.surface_gap - half_size), -o.max_shift, o.max_shift);
+  };
+  const double du = shift(&r->u, u_sensor, 0.5 * b->length), dv = shift(&r->v, v_sensor, 0.5 * b->width);
+  b->x += du * c - dv * s;
+  b->y += du * s + dv * c;
+  if (o.height) {
+    const double bottom = b->bottom();
+    const double top = quantileOf(&r->z, 0.995) + o.surface_gap;
+    b->height = std::clamp(top - bottom, 0.5 * b->height, 1.5 * b->height);
+    b->z = bottom + 0.5 * b->height;
+  }
+  return true;
+}
+
+bool refineCentroid(const PointCloud& cloud, const CellIndex& index, const PointRefineOptions& o, double offset,
+                    BoxReturns* r, Box* b) {
+  const double x0 = b->x, y0 = b->y;
+  bool moved = false;
+  for (int iteration = 0; iteration < 2; ++iteration) {
+    r->collect(cloud, index, *b, o.centroid_margin, o.ground_clearance, b->top());
+    if (static_cast<int>(r->u.size()) < o.min_points) break;
+    double mu = 0, mv = 0;
+    for (std::size_t i = 0; i < r->u.size(); ++i) mu += r->u[i], mv += r->v[i];
+    mu /= static_cast<double>(r->u.size()), mv /= static_cast<double>(r->u.size());
+    const double c = std::cos(b->yaw), s = std::sin(b->yaw);
+    const double mx = b->x + mu * c - mv * s, my = b->y + mu * s + mv * c, range = std::hypot(mx, my);
+    if (range < 1e-3) break;
+    b->x = mx + offset * mx / range;
+    b->y = my + offset * my / range;
+    moved = true;
+  }
+  const double d = std::hypot(b->x - x0, b->y - y0);
+  if (d > o.max_shift) {
+    b->x = x0 + (b->x - x0) * o.max_shift / d;
+    b->y = y0 + (b->y - y0) * o.max_shift / d;
+  }
+  return moved;
+}
+
 }  // namespace
 
 std::size_t refineBoxesFromPoints(const PointCloud& cloud, std::vector<Box>* boxes, const PointRefineOptions& o) {
-  auto refined = [&](const Box& b) {
-    return std::find(o.classes.begin(), o.classes.end(), b.label) != o.classes.end() && b.length > 0 &&
-           b.width > 0 && b.height > 0 && std::isfinite(b.x) && std::isfinite(b.y) && std::isfinite(b.yaw);
+  // The face classes' mode (1) or the centroid offset (2) of a box; 0 = not refined.
+  auto mode = [&](const Box& b, double* offset) {
+    if (!(b.length > 0 && b.width > 0 && b.height > 0 && std::isfinite(b.x) && std::isfinite(b.y) &&
+          std::isfinite(b.z) && std::isfinite(b.yaw)))
+      return 0;
+    if (std::find(o.faces.begin(), o.faces.end(), b.label) != o.faces.end()) return 1;
+    for (const auto& [c, off] : o.centroid)
+      if (c == b.label) return *offset = off, 2;
+    return 0;
   };
-  double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
+  double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300, offset = 0;
   for (const Box& b : *boxes) {
-    if (!refined(b)) continue;
-    const double r = 0.5 * std::hypot(b.length, b.width) + o.margin;
+    if (!mode(b, &offset)) continue;
+    const double r = 0.5 * std::hypot(b.length, b.width) + std::max(o.margin, o.centroid_margin) + o.max_shift;
     x0 = std::min(x0, b.x - r), y0 = std::min(y0, b.y - r);
     x1 = std::max(x1, b.x + r), y1 = std::max(y1, b.y + r);
   }
@@ -91,42 +176,11 @@ std::size_t refineBoxesFromPoints(const PointCloud& cloud, std::vector<Box>* box
   const CellIndex index(cloud, x0, y0, x1 + 1e-6, y1 + 1e-6, 1.0);
 
   std::size_t changed = 0;
-  std::vector<double> us, vs, zs;
+  BoxReturns returns;
   for (Box& b : *boxes) {
-    if (!refined(b)) continue;
-    const double c = std::cos(b.yaw), s = std::sin(b.yaw);
-    const double hl = 0.5 * b.length + o.margin, hw = 0.5 * b.width + o.margin;
-    const double z_lo = b.bottom() + o.ground_clearance, z_hi = b.top() + 2 * o.margin;
-    us.clear(), vs.clear(), zs.clear();
-    index.visit(b.x, b.y, std::hypot(hl, hw), [&](std::size_t i) {
-      const Point& p = cloud.points[i];
-      if (!(p.z > z_lo && p.z < z_hi)) return;
-      const double dx = p.x - b.x, dy = p.y - b.y;
-      const double u = dx * c + dy * s, v = -dx * s + dy * c;
-      if (std::abs(u) >= hl || std::abs(v) >= hw) return;
-      us.push_back(u), vs.push_back(v), zs.push_back(p.z);
-    });
-    if (static_cast<int>(us.size()) < o.min_points) continue;
-
-    // The sensor (the origin) in the box frame: a face is visible when the sensor lies beyond it.
-    const double u_sensor = -(b.x * c + b.y * s), v_sensor = b.x * s - b.y * c;
-    auto shift = [&](std::vector<double>* coord, double sensor, double half_size) {
-      if (std::abs(sensor) <= half_size) return 0.0;
-      const double sign = sensor > 0 ? 1.0 : -1.0;
-      for (double& x : *coord) x *= sign;
-      const double face = quantileOf(coord, o.quantile);
-      return std::clamp(sign * (face + o.surface_gap - half_size), -o.max_shift, o.max_shift);
-    };
-    const double du = shift(&us, u_sensor, 0.5 * b.length), dv = shift(&vs, v_sensor, 0.5 * b.width);
-    b.x += du * c - dv * s;
-    b.y += du * s + dv * c;
-    if (o.height) {
-      const double bottom = b.bottom();
-      const double top = quantileOf(&zs, 0.995) + o.surface_gap;
-      b.height = std::clamp(top - bottom, 0.5 * b.height, 1.5 * b.height);
-      b.z = bottom + 0.5 * b.height;
-    }
-    ++changed;
+    const int m = mode(b, &offset);
+    if (m == 1 && refineFaces(cloud, index, o, &returns, &b)) ++changed;
+    if (m == 2 && refineCentroid(cloud, index, o, offset, &returns, &b)) ++changed;
   }
   return changed;
 }

@@ -52,7 +52,7 @@ Box moved(Box b, double du, double dv) {
 
 PointRefineOptions carsOnly() {
   PointRefineOptions o;
-  o.classes = {ObjectClass::Car};
+  o.faces = {ObjectClass::Car};
   o.quantile = 1.0;  // clean synthetic faces: the outermost return is the face
   return o;
 }
@@ -160,13 +160,47 @@ TEST(PointRefine, StrayReturnsAreOutvotedByTheQuantile) {
   EXPECT_LT(std::hypot(boxes[0].x - truth.x, boxes[0].y - truth.y), 0.03);
 }
 
+TEST(PointRefine, PutsASmallObjectBehindTheCentroidOfItsReturns) {
+  // A pedestrian-sized column of returns on the near half of a 0.3 m cylinder around (14, -6): their centroid lies
+  // in front of the centre, by the offset the options give.
+  const double cx = 14, cy = -6, radius = 0.15, bearing = std::atan2(cy, cx);
+  PointCloud cloud;
+  for (double z = -1.2; z < 0.0; z += 0.1)
+    for (double a = -1.2; a <= 1.2; a += 0.2) {
+      Point p;
+      p.x = static_cast<float>(cx - radius * std::cos(bearing + a));
+      p.y = static_cast<float>(cy - radius * std::sin(bearing + a));
+      p.z = static_cast<float>(z);
+      cloud.push_back(p);
+    }
+  double mx = 0, my = 0;
+  for (const Point& p : cloud.points) mx += p.x, my += p.y;
+  mx /= static_cast<double>(cloud.size()), my /= static_cast<double>(cloud.size());
+  const double offset = std::hypot(cx - mx, cy - my);
+  Box guess = carBox(cx + 0.12, cy + 0.08, 0.4, 0.8, 0.6, 1.75);
+  guess.label = ObjectClass::Pedestrian;
+  PointRefineOptions o;
+  o.centroid = {{ObjectClass::Pedestrian, offset}};
+  std::vector<Box> boxes = {guess};
+  EXPECT_EQ(refineBoxesFromPoints(cloud, &boxes, o), 1u);
+  EXPECT_NEAR(boxes[0].x, cx, 0.01);
+  EXPECT_NEAR(boxes[0].y, cy, 0.01);
+  EXPECT_DOUBLE_EQ(boxes[0].height, guess.height);  // only the centre moves
+  EXPECT_DOUBLE_EQ(boxes[0].yaw, guess.yaw);
+}
+
 TEST(PointRefine, OptionsAreReadFromYamlAndMistakesRefused) {
-  const auto o = detectorOptionsFromYaml("inference:\n  point_refine: {classes: [Car, Cyclist], quantile: 0.8}\n");
-  ASSERT_EQ(o.inference.point_refine.classes.size(), 2u);
-  EXPECT_EQ(o.inference.point_refine.classes[1], ObjectClass::Cyclist);
+  const auto o = detectorOptionsFromYaml(
+      "inference:\n  point_refine: {faces: [Car, Cyclist], quantile: 0.8, centroid: {Pedestrian: 0.1}}\n");
+  ASSERT_EQ(o.inference.point_refine.faces.size(), 2u);
+  EXPECT_EQ(o.inference.point_refine.faces[1], ObjectClass::Cyclist);
   EXPECT_DOUBLE_EQ(o.inference.point_refine.quantile, 0.8);
+  ASSERT_EQ(o.inference.point_refine.centroid.size(), 1u);
+  EXPECT_EQ(o.inference.point_refine.centroid[0].first, ObjectClass::Pedestrian);
+  EXPECT_DOUBLE_EQ(o.inference.point_refine.centroid[0].second, 0.1);
   EXPECT_FALSE(detectorOptionsFromYaml("inference: {}").inference.point_refine.enabled());
-  for (const std::string bad : {"classes: [Truck]", "quantile: 0", "quantile: 1.5", "min_points: 0", "margn: 0.3",
+  for (const std::string bad : {"faces: [Truck]", "centroid: {Truck: 0.1}", "centroid: {Car: 0.1}, faces: [Car]",
+                                "centroid: {Pedestrian: 3}", "quantile: 0", "quantile: 1.5", "min_points: 0", "margn: 0.3",
                                 "max_shift: -1"}) {
     try {
       detectorOptionsFromYaml("inference:\n  point_refine: {" + bad + "}\n");

@@ -1,7 +1,11 @@
-// Box refinement from the points: the BEV grid (0.25 m cells) blurs where an object's faces are, but the raw returns
-// on the faces the sensor sees fix them to a few centimetres. After NMS each box of a rigid class (cars) is moved so
-// that its sides facing the sensor touch the visible faces (keeping the predicted length and width), and its top is
-// set from the highest returns (keeping the bottom). Faces hidden from the sensor keep the network's estimate.
+// Box refinement from the points: the BEV grid (0.25 m cells) blurs where an object is, but its raw returns fix it
+// to a few centimetres. After NMS:
+// - faces (rigid boxy classes: cars): the box is moved so that its sides facing the sensor touch the visible faces
+//   (keeping the predicted length and width), and its top is set from the highest returns (keeping the bottom).
+//   Faces hidden from the sensor keep the network's estimate.
+// - centroid (small classes: pedestrians, cyclists): the box centre is put at the centroid of its returns moved away
+//   from the sensor by a per-class offset (the visible surface lies in front of the centre; measured on training
+//   data), twice, so that the returns are re-selected around the moved box.
 #pragma once
 
 #include <vector>
@@ -11,7 +15,9 @@
 namespace ret3d {
 
 struct PointRefineOptions {
-  std::vector<ObjectClass> classes;  // the classes refined; empty = off
+  std::vector<ObjectClass> faces;    // the classes refined by their faces
+  // The classes refined by their centroid, each with the offset of its box centre behind the centroid (m).
+  std::vector<std::pair<ObjectClass, double>> centroid;
   // A face's position: this quantile of the returns' coordinate toward the sensor (robust to stray returns).
   double quantile = 0.9;
   double surface_gap = 0.05;       // box side beyond the outermost surface (m), as labellers draw boxes
@@ -19,9 +25,10 @@ struct PointRefineOptions {
   double ground_clearance = 0.3;   // returns less than this above the box bottom are taken as ground (m)
   double max_shift = 0.6;          // largest move of the centre along each box axis (m)
   int min_points = 3;              // fewer returns: the box is left as it is
-  bool height = true;              // also set the top from the highest returns
+  bool height = true;              // faces: also set the top from the highest returns
+  double centroid_margin = 0.1;    // centroid: returns within this distance outside the box count (m)
 
-  bool enabled() const { return !classes.empty(); }
+  bool enabled() const { return !faces.empty() || !centroid.empty(); }
   // Throws std::invalid_argument naming the field when a value is out of range.
   void validate() const;
 };
