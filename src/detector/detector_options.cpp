@@ -184,6 +184,8 @@ void readInference(MapReader r, InferenceOptions* o) {
       o->point_refine.centroid.emplace_back(*c, offset);
     }
     p.get("centroid_margin", &o->point_refine.centroid_margin);
+    p.get("centroid_height", &o->point_refine.centroid_height);
+    p.get("vertical_resolution_deg", &o->point_refine.vertical_resolution_deg);
     p.get("quantile", &o->point_refine.quantile);
     p.get("surface_gap", &o->point_refine.surface_gap);
     p.get("margin", &o->point_refine.margin);

@@ -20,6 +20,8 @@ void PointRefineOptions::validate() const {
       fail("centroid", std::string("lists ") + className(c) + ", which faces refines already");
   }
   if (!(centroid_margin >= 0 && centroid_margin < 5)) fail("centroid_margin", "must lie in [0, 5) m");
+  if (!(vertical_resolution_deg >= 0 && vertical_resolution_deg < 10))
+    fail("vertical_resolution_deg", "must lie in [0, 10) deg");
   if (!(quantile > 0 && quantile <= 1)) fail("quantile", "must lie in (0, 1]");
   if (!(surface_gap >= 0 && surface_gap < 1)) fail("surface_gap", "must lie in [0, 1) m");
   if (!(margin >= 0 && margin < 5)) fail("margin", "must lie in [0, 5) m");
@@ -30,11 +32,11 @@ void PointRefineOptions::validate() const {
 
 namespace {
 
-// The returns binned in square cells over the area the boxes cover (a counting sort), so that each box visits
-// only the returns near it.
+// The returns between heights z0 and z1 binned in square cells over the area the boxes cover (a counting sort), so
+// that each box visits only the returns near it (ground returns, most of a scan, are left out by z0).
 class CellIndex {
  public:
-  CellIndex(const PointCloud& cloud, double x0, double y0, double x1, double y1, double cell)
+  CellIndex(const PointCloud& cloud, double x0, double y0, double x1, double y1, double z0, double z1, double cell)
       : x0_(x0), y0_(y0), cell_(cell) {
     nx_ = std::max(1, static_cast<int>(std::ceil((x1 - x0) / cell)));
     ny_ = std::max(1, static_cast<int>(std::ceil((y1 - y0) / cell)));
@@ -43,7 +45,7 @@ class CellIndex {
     for (std::size_t i = 0; i < cloud.size(); ++i) {
       const Point& p = cloud.points[i];
       const int cx = cellX(p.x), cy = cellY(p.y);
-      if (cx < 0 || cy < 0 || cx >= nx_ || cy >= ny_ || !std::isfinite(p.z)) continue;
+      if (cx < 0 || cy < 0 || cx >= nx_ || cy >= ny_ || !(p.z > z0 && p.z < z1)) continue;
       cell_of[i] = cy * nx_ + cx;
       ++start_[static_cast<std::size_t>(cell_of[i]) + 1];
     }
@@ -101,6 +103,17 @@ struct BoxReturns {
   }
 };
 
+// The top from the highest returns (the bottom stays): the network's top clamped to what the returns allow.
+void refineTop(const PointRefineOptions& o, std::vector<double>* z, Box* b) {
+  if (z->empty()) return;
+  const double bottom = b->bottom();
+  const double highest = quantileOf(z, 0.995) + o.surface_gap;
+  const double slack = std::hypot(b->x, b->y) * std::tan(o.vertical_resolution_deg * M_PI / 180.0);
+  const double top = std::clamp(b->top(), highest, highest + slack);
+  b->height = std::clamp(top - bottom, 0.5 * b->height, 1.5 * b->height);
+  b->z = bottom + 0.5 * b->height;
+}
+
 bool refineFaces(const PointCloud& cloud, const CellIndex& index, const PointRefineOptions& o, BoxReturns* r,
                  Box* b) {
   r->collect(cloud, index, *b, o.margin, o.ground_clearance, b->top() + 2 * o.margin);
@@ -118,12 +131,7 @@ bool refineFaces(const PointCloud& cloud, const CellIndex& index, const PointRef
   const double du = shift(&r->u, u_sensor, 0.5 * b->length), dv = shift(&r->v, v_sensor, 0.5 * b->width);
   b->x += du * c - dv * s;
   b->y += du * s + dv * c;
-  if (o.height) {
-    const double bottom = b->bottom();
-    const double top = quantileOf(&r->z, 0.995) + o.surface_gap;
-    b->height = std::clamp(top - bottom, 0.5 * b->height, 1.5 * b->height);
-    b->z = bottom + 0.5 * b->height;
-  }
+  if (o.height) refineTop(o, &r->z, b);
   return true;
 }
 
@@ -149,6 +157,10 @@ bool refineCentroid(const PointCloud& cloud, const CellIndex& index, const Point
     b->x = x0 + (b->x - x0) * o.max_shift / d;
     b->y = y0 + (b->y - y0) * o.max_shift / d;
   }
+  if (moved && o.centroid_height) {
+    r->collect(cloud, index, *b, o.centroid_margin, o.ground_clearance, b->top() + 2 * o.centroid_margin);
+    refineTop(o, &r->z, b);
+  }
   return moved;
 }
 
@@ -165,15 +177,16 @@ std::size_t refineBoxesFromPoints(const PointCloud& cloud, std::vector<Box>* box
       if (c == b.label) return *offset = off, 2;
     return 0;
   };
-  double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300, offset = 0;
+  double x0 = 1e300, y0 = 1e300, z0 = 1e300, x1 = -1e300, y1 = -1e300, z1 = -1e300, offset = 0;
   for (const Box& b : *boxes) {
     if (!mode(b, &offset)) continue;
-    const double r = 0.5 * std::hypot(b.length, b.width) + std::max(o.margin, o.centroid_margin) + o.max_shift;
-    x0 = std::min(x0, b.x - r), y0 = std::min(y0, b.y - r);
-    x1 = std::max(x1, b.x + r), y1 = std::max(y1, b.y + r);
+    const double margin = std::max(o.margin, o.centroid_margin);
+    const double r = 0.5 * std::hypot(b.length, b.width) + margin + o.max_shift;
+    x0 = std::min(x0, b.x - r), y0 = std::min(y0, b.y - r), z0 = std::min(z0, b.bottom() + o.ground_clearance);
+    x1 = std::max(x1, b.x + r), y1 = std::max(y1, b.y + r), z1 = std::max(z1, b.top() + 2 * margin);
   }
   if (x0 > x1 || cloud.empty()) return 0;
-  const CellIndex index(cloud, x0, y0, x1 + 1e-6, y1 + 1e-6, 1.0);
+  const CellIndex index(cloud, x0, y0, x1 + 1e-6, y1 + 1e-6, z0, z1, 1.0);
 
   std::size_t changed = 0;
   BoxReturns returns;

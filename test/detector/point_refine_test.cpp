@@ -98,6 +98,16 @@ TEST(PointRefine, SetsTheTopFromTheHighestReturnsAndKeepsTheBottom) {
   EXPECT_NEAR(boxes[0].height, truth.height, 0.01);
   EXPECT_NEAR(boxes[0].bottom(), truth.bottom(), 1e-9);
 
+  // With a beam spacing, a top above the highest return by less than the slack (range x spacing) is kept.
+  PointRefineOptions sparse_beams = carsOnly();
+  sparse_beams.vertical_resolution_deg = 1.0;  // slack 0.19 m at 10.6 m
+  Box taller = truth;
+  taller.height = truth.height + 0.1;
+  taller.z = truth.bottom() + 0.5 * taller.height;
+  boxes = {taller};
+  refineBoxesFromPoints(cloud, &boxes, sparse_beams);
+  EXPECT_NEAR(boxes[0].height, taller.height, 1e-9);
+
   PointRefineOptions no_height = carsOnly();
   no_height.height = false;
   boxes = {guess};
