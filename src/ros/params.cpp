@@ -164,6 +164,8 @@ DetectorNodeletParams loadDetectorNodeletParams(const ros::NodeHandle& private_n
   inf.nms_iou = p.number("nms_iou", inf.nms_iou, 0.01, 1.0);
   inf.nms_voting_iou = p.number("nms_voting_iou", inf.nms_voting_iou, 0.0, 1.0);
   inf.iou_score_power = p.number("iou_score_power", inf.iou_score_power, 0.0, 1.0);
+  // The model file's point refinement (boxes fitted to the raw returns) can only be switched off here.
+  if (!p.boolean("point_refine", true)) inf.point_refine = PointRefineOptions();
   inf.max_detections = p.integer("max_detections", inf.max_detections, 1, 100000);
   const std::string scaling =
       p.choice("intensity_scaling", "auto", {"auto", "datatype", "observed_max", "fixed"});
