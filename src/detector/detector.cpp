@@ -83,6 +83,7 @@ Detections Detector::detect(const PointCloud& current, const PointCloud* previou
 
   t0 = std::chrono::steady_clock::now();
   if (options_.inference.point_refine.enabled()) refineBoxesFromPoints(current, &det.boxes, options_.inference.point_refine);
+  headingFromVelocity(&det.boxes, options_.inference.heading_from_velocity);
   timings_.refine_ms = msSince(t0);
 
   // The features o_i belong to decoding (Ret3D §3.1): timed with it.

@@ -112,6 +112,19 @@ void readClasses(MapReader& r, const std::string& key, std::vector<ObjectClass>*
   }
 }
 
+// A map from class names to numbers under `key`, e.g. centroid: {Pedestrian: 0.1}.
+void readClassValues(MapReader& r, const std::string& key, std::vector<std::pair<ObjectClass, double>>* out) {
+  std::map<std::string, double> values;
+  for (const auto& [c, v] : *out) values[className(c)] = v;
+  r.get(key, &values);
+  out->clear();
+  for (const auto& [name, v] : values) {
+    const auto c = classFromName(name);
+    if (!c) r.fail(r.full(key), "unknown class '" + name + "' (Car, Pedestrian, Cyclist)");
+    out->emplace_back(*c, v);
+  }
+}
+
 void readModel(MapReader r, ModelConfig* m) {
   readClasses(r, "classes", &m->classes);
   {
@@ -171,18 +184,13 @@ void readInference(MapReader r, InferenceOptions* o) {
   r.get("nms_iou", &o->nms_iou);
   r.get("nms_voting_iou", &o->nms_voting_iou);
   r.get("iou_score_power", &o->iou_score_power);
+  readClassValues(r, "heading_from_velocity", &o->heading_from_velocity);
+  for (const auto& [c, speed] : o->heading_from_velocity)
+    if (!(speed >= 0)) r.fail(r.full("heading_from_velocity"), "speeds must be >= 0 m/s");
   {
     MapReader p = r.child("point_refine");
     readClasses(p, "faces", &o->point_refine.faces);
-    std::map<std::string, double> centroid;
-    for (const auto& [c, offset] : o->point_refine.centroid) centroid[className(c)] = offset;
-    p.get("centroid", &centroid);
-    o->point_refine.centroid.clear();
-    for (const auto& [name, offset] : centroid) {
-      const auto c = classFromName(name);
-      if (!c) p.fail(p.full("centroid"), "unknown class '" + name + "' (Car, Pedestrian, Cyclist)");
-      o->point_refine.centroid.emplace_back(*c, offset);
-    }
+    readClassValues(p, "centroid", &o->point_refine.centroid);
     p.get("centroid_margin", &o->point_refine.centroid_margin);
     p.get("centroid_height", &o->point_refine.centroid_height);
     p.get("vertical_resolution_deg", &o->point_refine.vertical_resolution_deg);

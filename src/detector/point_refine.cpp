@@ -198,4 +198,15 @@ std::size_t refineBoxesFromPoints(const PointCloud& cloud, std::vector<Box>* box
   return changed;
 }
 
+std::size_t headingFromVelocity(std::vector<Box>* boxes, const std::vector<std::pair<ObjectClass, double>>& min_speed) {
+  std::size_t changed = 0;
+  for (Box& b : *boxes)
+    for (const auto& [c, speed] : min_speed)
+      if (c == b.label && std::hypot(b.vx, b.vy) >= speed && std::isfinite(b.vx) && std::isfinite(b.vy)) {
+        b.yaw = std::atan2(b.vy, b.vx);
+        ++changed;
+      }
+  return changed;
+}
+
 }  // namespace ret3d

@@ -199,6 +199,22 @@ TEST(PointRefine, PutsASmallObjectBehindTheCentroidOfItsReturns) {
   EXPECT_DOUBLE_EQ(boxes[0].yaw, guess.yaw);
 }
 
+TEST(HeadingFromVelocity, MovingBoxesOfTheListedClassesFaceTheirVelocity) {
+  Box walker = carBox(5, 5, 0.0, 0.8, 0.6, 1.7);
+  walker.label = ObjectClass::Pedestrian;
+  walker.vx = -0.6, walker.vy = 0.6;  // 0.85 m/s towards the upper left
+  Box standing = walker;
+  standing.vx = 0.1, standing.vy = 0.0;  // below the speed: its heading stays
+  Box car = carBox(10, 0, 0.2);
+  car.vx = 0.0, car.vy = 5.0;  // cars are not listed
+  std::vector<Box> boxes = {walker, standing, car};
+  EXPECT_EQ(headingFromVelocity(&boxes, {{ObjectClass::Pedestrian, 0.3}}), 1u);
+  EXPECT_NEAR(boxes[0].yaw, 3 * M_PI / 4, 1e-12);
+  EXPECT_DOUBLE_EQ(boxes[1].yaw, 0.0);
+  EXPECT_DOUBLE_EQ(boxes[2].yaw, 0.2);
+  EXPECT_EQ(headingFromVelocity(&boxes, {}), 0u);
+}
+
 TEST(PointRefine, OptionsAreReadFromYamlAndMistakesRefused) {
   const auto o = detectorOptionsFromYaml(
       "inference:\n  point_refine: {faces: [Car, Cyclist], quantile: 0.8, centroid: {Pedestrian: 0.1}}\n");
@@ -209,6 +225,11 @@ TEST(PointRefine, OptionsAreReadFromYamlAndMistakesRefused) {
   EXPECT_EQ(o.inference.point_refine.centroid[0].first, ObjectClass::Pedestrian);
   EXPECT_DOUBLE_EQ(o.inference.point_refine.centroid[0].second, 0.1);
   EXPECT_FALSE(detectorOptionsFromYaml("inference: {}").inference.point_refine.enabled());
+  const auto h = detectorOptionsFromYaml("inference: {heading_from_velocity: {Pedestrian: 0.3}}");
+  ASSERT_EQ(h.inference.heading_from_velocity.size(), 1u);
+  EXPECT_DOUBLE_EQ(h.inference.heading_from_velocity[0].second, 0.3);
+  EXPECT_THROW(detectorOptionsFromYaml("inference: {heading_from_velocity: {Pedestrian: -1}}"), std::runtime_error);
+  EXPECT_THROW(detectorOptionsFromYaml("inference: {heading_from_velocity: {Walker: 1}}"), std::runtime_error);
   for (const std::string bad : {"faces: [Truck]", "centroid: {Truck: 0.1}", "centroid: {Car: 0.1}, faces: [Car]",
                                 "centroid: {Pedestrian: 3}", "quantile: 0", "quantile: 1.5", "min_points: 0", "margn: 0.3",
                                 "max_shift: -1"}) {

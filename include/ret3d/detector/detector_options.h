@@ -83,6 +83,8 @@ struct InferenceOptions {
   double iou_score_power = 0.5;
   // Box refinement from the raw returns after NMS (point_refine.h); off unless classes are listed.
   PointRefineOptions point_refine;
+  // Per class, the speed (m/s) from which a box takes the heading of its velocity (headingFromVelocity); empty = off.
+  std::vector<std::pair<ObjectClass, double>> heading_from_velocity;
 };
 
 struct TrainOptions {
