@@ -201,6 +201,8 @@ void readInference(MapReader r, InferenceOptions* o) {
     p.get("max_shift", &o->point_refine.max_shift);
     p.get("min_points", &o->point_refine.min_points);
     p.get("height", &o->point_refine.height);
+    p.get("hidden_midpoint", &o->point_refine.hidden_midpoint);
+    p.get("grow", &o->point_refine.grow);
     p.finish();
     try {
       o->point_refine.validate();

@@ -121,14 +121,32 @@ bool refineFaces(const PointCloud& cloud, const CellIndex& index, const PointRef
   const double c = std::cos(b->yaw), s = std::sin(b->yaw);
   // The sensor (the origin) in the box frame: a face is visible when the sensor lies beyond it.
   const double u_sensor = -(b->x * c + b->y * s), v_sensor = b->x * s - b->y * c;
-  auto shift = [&](std::vector<double>* coord, double sensor, double half_size) {
-    if (std::abs(sensor) <= half_size) return 0.0;
+  // Along one box axis: the move of the centre, and (grow) the size the returns need.
+  auto shift = [&](std::vector<double>* coord, double sensor, double* size) {
+    const double half_size = 0.5 * *size;
+    if (std::abs(sensor) <= half_size) {
+      // Both faces hidden: the visible perpendicular face spans this axis, so its returns centre the box.
+      if (!o.hidden_midpoint) return 0.0;
+      const double lo = quantileOf(coord, 1 - o.quantile), hi = quantileOf(coord, o.quantile);
+      return std::clamp(0.5 * (lo + hi), -o.max_shift, o.max_shift);
+    }
     const double sign = sensor > 0 ? 1.0 : -1.0;
     for (double& x : *coord) x *= sign;
     const double face = quantileOf(coord, o.quantile);
-    return std::clamp(sign * (face + o.surface_gap - half_size), -o.max_shift, o.max_shift);
+    const double d = std::clamp(sign * (face + o.surface_gap - half_size), -o.max_shift, o.max_shift);
+    if (!o.grow) return d;
+    // The far face must hold the returns seen beyond it (a side seen along its whole length).
+    const double far = quantileOf(coord, 1 - o.quantile) - o.surface_gap;  // toward the sensor = positive
+    const double near_face = sign * d + half_size;
+    const double need = near_face - far;
+    if (need > *size && need < *size + o.max_shift) {
+      const double grow = need - *size;
+      *size = need;
+      return d - sign * 0.5 * grow;
+    }
+    return d;
   };
-  const double du = shift(&r->u, u_sensor, 0.5 * b->length), dv = shift(&r->v, v_sensor, 0.5 * b->width);
+  const double du = shift(&r->u, u_sensor, &b->length), dv = shift(&r->v, v_sensor, &b->width);
   b->x += du * c - dv * s;
   b->y += du * s + dv * c;
   if (o.height) refineTop(o, &r->z, b);

@@ -149,12 +149,13 @@ detail::MotSequence prepare(const std::vector<EvalFrame>& frames, std::size_t be
                             const MotOptions& options, std::size_t& removed, int& num_pred_tracks) {
   detail::MotSequence seq;
   std::map<std::uint32_t, int> gt_ids, pred_ids;
+  auto inRange = [&](const Box& b) { return !(options.max_range > 0) || std::hypot(b.x, b.y) <= options.max_range; };
   for (std::size_t i = begin; i < end; ++i) {
     const EvalFrame& f = frames[i];
     std::vector<const Box*> gt, ignored, pred;
     for (std::size_t g = 0; g < f.gt_boxes.size(); ++g) {
       const Box& b = f.gt_boxes[g];
-      if (b.label != cls) continue;
+      if (b.label != cls || !inRange(b)) continue;
       if (g < f.gt_ignore.size() && f.gt_ignore[g]) {
         ignored.push_back(&b);
         continue;
@@ -166,7 +167,7 @@ detail::MotSequence prepare(const std::vector<EvalFrame>& frames, std::size_t be
       gt.push_back(&b);
     }
     for (const Box& b : f.pred_boxes) {
-      if (b.label != cls) continue;
+      if (b.label != cls || !inRange(b)) continue;
       if (b.track_id == 0) {
         throw std::invalid_argument("tracking metrics: a predicted " + std::string(className(cls)) +
                                     " has no track id (" + where(f) + ")");

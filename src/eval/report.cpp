@@ -146,6 +146,7 @@ std::map<std::string, double> metricsMap(const EvalReport& r) {
     }
   }
   if (r.mot) {
+    m["mot_detail.max_range"] = r.mot_options.max_range;
     for (const auto& c : r.mot->classes) {
       const std::string p = "mot." + std::string(className(c.cls)) + ".";
       const double tracks = std::max(1, c.clear.num_gt_tracks);
@@ -211,8 +212,9 @@ std::string headlineTable(const EvalReport& r) {
     o << line;
   }
   if (r.mot) {
-    o << "Tracking (" << similarityName(r.mot_options.similarity) << " >= " << r.mot_options.threshold
-      << ")   MOTA    MOTP   IDSW   FRAG    HOTA    DetA    AssA\n";
+    o << "Tracking (" << similarityName(r.mot_options.similarity) << " >= " << r.mot_options.threshold;
+    if (r.mot_options.max_range > 0) o << ", within " << r.mot_options.max_range << " m";
+    o << ")   MOTA    MOTP   IDSW   FRAG    HOTA    DetA    AssA\n";
     for (const auto& c : r.mot->classes) {
       std::snprintf(line, sizeof line, "  %-10s          %7.2f %7.2f %6d %6d %7.2f %7.2f %7.2f\n", className(c.cls),
                     c.clear.mota, c.clear.motp, c.clear.idsw, c.clear.frag, c.hota.hota, c.hota.deta, c.hota.assa);
@@ -423,7 +425,11 @@ std::vector<std::string> writeReport(const std::string& dir, const EvalReport& r
     md << "## Tracking (CLEAR MOT and HOTA, per class)\n\n"
        << "Similarity: " << similarityName(o.similarity);
     if (o.similarity == MotSimilarity::CenterDistance) md << " (1 - d / " << fmt(o.zero_distance) << " m)";
-    md << "; CLEAR matches need similarity >= " << fmt(o.threshold) << "; HOTA averages over alpha 0.05..0.95. "
+    md << "; CLEAR matches need similarity >= " << fmt(o.threshold) << "; HOTA averages over alpha 0.05..0.95. ";
+    if (o.max_range > 0)
+      md << "Only boxes within " << fmt(o.max_range) << " m of the sensor (BEV) are evaluated, ground truth and "
+         << "predictions alike. ";
+    md
        << "MOTA, MOTP, HOTA, DetA, AssA in percent; IDSW and FRAG are counts; MT / ML in percent of ground-truth "
           "tracks (tracked > 80 % / < 20 % of their frames). Definitions as TrackEval. "
        << r.mot->num_sequences << " sequences; " << r.mot->removed_on_ignore

@@ -37,7 +37,7 @@ struct EvalArgs {
   std::string calib;
   double bag_rate = 10.0, bag_start_time = 1.0e9, stamp_tolerance = 1e-3;
   std::string mot_similarity = "iou3d";
-  double mot_threshold = 0.5, mot_zero_distance = 2.0;
+  double mot_threshold = 0.5, mot_zero_distance = 2.0, mot_max_range = 0;
   int threads = 2;
 };
 
@@ -238,6 +238,7 @@ int runEval(const EvalArgs& a) {
       o.threads = a.threads;
       o.threshold = a.mot_threshold;
       o.zero_distance = a.mot_zero_distance;
+      o.max_range = a.mot_max_range;
       if (a.mot_similarity == "iou3d") {
         o.similarity = MotSimilarity::Iou3d;
       } else if (a.mot_similarity == "bev") {
@@ -298,6 +299,10 @@ CommandRegistrar registrar(
           ->capture_default_str();
       app.add_option("--mot-zero-distance", a->mot_zero_distance, "center similarity: metres at which it reaches 0")
           ->capture_default_str();
+      app.add_option("--mot-max-range", a->mot_max_range,
+                     "tracking metrics: leave out boxes further than this from the sensor, m (0 = all)")
+          ->capture_default_str()
+          ->check(CLI::NonNegativeNumber);
       app.add_option("--threads", a->threads, "worker threads")->capture_default_str()->check(CLI::PositiveNumber);
       return [a]() -> int { return runEval(*a); };
     });

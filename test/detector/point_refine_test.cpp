@@ -81,6 +81,51 @@ TEST(PointRefine, AHiddenFaceKeepsTheNetworksEstimate) {
   EXPECT_NEAR(boxes[0].y, truth.y + 0.2, 1e-9);
 }
 
+TEST(PointRefine, EndOnTheVisibleFaceCentresTheHiddenAxis) {
+  // The same end-on car with hidden_midpoint: the rear face spans the car's width, so its returns centre it across.
+  const Box truth = carBox(15, 0, 0);
+  const PointCloud cloud = visibleFaces(truth);
+  PointRefineOptions o = carsOnly();
+  o.hidden_midpoint = true;
+  std::vector<Box> boxes = {moved(truth, -0.3, 0.2)};
+  refineBoxesFromPoints(cloud, &boxes, o);
+  EXPECT_NEAR(boxes[0].x, truth.x, 0.01);
+  EXPECT_NEAR(boxes[0].y, truth.y, 0.01);
+  EXPECT_DOUBLE_EQ(boxes[0].width, truth.width);
+  // Seen a little off-axis the face is still centred; an axis whose face is seen keeps the face fit.
+  const Box offset = carBox(15, 0.6, 0.02);
+  boxes = {moved(offset, 0.2, -0.25)};
+  refineBoxesFromPoints(visibleFaces(offset), &boxes, o);
+  EXPECT_NEAR(boxes[0].x, offset.x, 0.01);
+  EXPECT_NEAR(boxes[0].y, offset.y, 0.01);
+}
+
+TEST(PointRefine, GrowsASizeToHoldTheReturnsOfASideSeenWhole) {
+  // Seen obliquely, the right side is seen from end to end: a box 0.2 m too short, its rear on the rear face, grows
+  // forward to the front end of the side; a box too long is not shrunk (the side may be occluded).
+  const Box truth = carBox(12, 6, 0.3);
+  const PointCloud cloud = visibleFaces(truth);
+  PointRefineOptions o = carsOnly();
+  o.grow = true;
+  Box shorter = moved(truth, -0.1, 0);
+  shorter.length = truth.length - 0.2;
+  std::vector<Box> boxes = {shorter};
+  refineBoxesFromPoints(cloud, &boxes, o);
+  EXPECT_NEAR(boxes[0].length, truth.length, 0.01);
+  EXPECT_NEAR(boxes[0].x, truth.x, 0.01);
+  EXPECT_NEAR(boxes[0].y, truth.y, 0.01);
+  EXPECT_NEAR(boxes[0].width, truth.width, 1e-3);
+  Box longer = moved(truth, 0.2, 0);
+  longer.length = truth.length + 0.4;
+  boxes = {longer};
+  refineBoxesFromPoints(cloud, &boxes, o);
+  EXPECT_DOUBLE_EQ(boxes[0].length, longer.length);
+  // Without grow the length is the network's.
+  boxes = {shorter};
+  refineBoxesFromPoints(cloud, &boxes, carsOnly());
+  EXPECT_DOUBLE_EQ(boxes[0].length, shorter.length);
+}
+
 TEST(PointRefine, SetsTheTopFromTheHighestReturnsAndKeepsTheBottom) {
   const Box truth = carBox(8, -7, -1.2, 4.0, 1.7, 1.62);
   PointCloud cloud = visibleFaces(truth);
@@ -224,6 +269,10 @@ TEST(PointRefine, OptionsAreReadFromYamlAndMistakesRefused) {
   ASSERT_EQ(o.inference.point_refine.centroid.size(), 1u);
   EXPECT_EQ(o.inference.point_refine.centroid[0].first, ObjectClass::Pedestrian);
   EXPECT_DOUBLE_EQ(o.inference.point_refine.centroid[0].second, 0.1);
+  EXPECT_FALSE(o.inference.point_refine.hidden_midpoint);
+  const auto m = detectorOptionsFromYaml("inference:\n  point_refine: {faces: [Car], hidden_midpoint: true, grow: true}\n");
+  EXPECT_TRUE(m.inference.point_refine.hidden_midpoint);
+  EXPECT_TRUE(m.inference.point_refine.grow);
   EXPECT_FALSE(detectorOptionsFromYaml("inference: {}").inference.point_refine.enabled());
   const auto h = detectorOptionsFromYaml("inference: {heading_from_velocity: {Pedestrian: 0.3}}");
   ASSERT_EQ(h.inference.heading_from_velocity.size(), 1u);

@@ -154,6 +154,30 @@ TEST(MotMetrics, PredictionsOnIgnoredGroundTruthAreRemoved) {
   EXPECT_NEAR(carResult(all).clear.mota, 100.0, 1e-9);
 }
 
+// max_range leaves out what lies beyond it, ground truth and predictions alike: a missed far car (frames 0-9 at x =
+// 60 + t) and a false far track (x = -55) stop counting, while a near false positive still does.
+TEST(MotMetrics, MaxRangeLeavesOutFarBoxes) {
+  auto frames = groundTruth();
+  for (auto& f : frames) {
+    f.gt_boxes.push_back(car(60 + f.frame, 0, 3));
+    f.gt_ignore.push_back(0);
+    f.pred_boxes = {car(f.frame, 0, 7), car(f.frame, 10, 8), car(-55, 0, 9)};
+    if (f.frame == 0) f.pred_boxes.push_back(car(0, -20, 10));
+  }
+  const MotResult all = evaluateMot(frames);
+  EXPECT_EQ(carResult(all).clear.fn, 10);
+  EXPECT_EQ(carResult(all).clear.fp, 11);
+  EXPECT_NEAR(carResult(all).clear.mota, 100.0 * (1 - 21.0 / 30.0), 1e-9);
+  MotOptions o;
+  o.max_range = 50;
+  const MotResult near = evaluateMot(frames, o);
+  EXPECT_EQ(carResult(near).clear.num_gt, 20);
+  EXPECT_EQ(carResult(near).clear.fn, 0);
+  EXPECT_EQ(carResult(near).clear.fp, 1);
+  EXPECT_NEAR(carResult(near).clear.mota, 95.0, 1e-9);
+  EXPECT_EQ(carResult(near).num_pred_tracks, 3);
+}
+
 TEST(MotMetrics, CentreDistanceSimilarity) {
   MotOptions o;
   o.similarity = MotSimilarity::CenterDistance;

@@ -33,6 +33,11 @@ struct PointRefineOptions {
   // highest return is the top (on the tuning set 0.15 and 0 scored alike, 0.4 lower).
   double vertical_resolution_deg = 0.0;
   double centroid_margin = 0.1;    // centroid: returns within this distance outside the box count (m)
+  // faces: along an axis whose faces the sensor cannot see (a car seen end-on), the centre is the midpoint of the
+  // returns of the visible face, which spans that axis.
+  bool hidden_midpoint = false;
+  // faces: a size grows (keeping the visible face) to hold the returns seen beyond the far face.
+  bool grow = false;
 
   bool enabled() const { return !faces.empty() || !centroid.empty(); }
   // Throws std::invalid_argument naming the field when a value is out of range.

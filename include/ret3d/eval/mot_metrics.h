@@ -40,6 +40,9 @@ struct MotOptions {
   MotSimilarity similarity = MotSimilarity::Iou3d;
   double threshold = 0.5;      // CLEAR: minimum similarity of a match (and of the ignore-region matching)
   double zero_distance = 2.0;  // CenterDistance: metres at which the similarity reaches 0
+  // > 0: ground truth (ignored boxes too) and predictions whose centre lies further than this from the sensor (BEV,
+  // LiDAR frame) are left out, as nuScenes' class ranges do, so that a detector is scored over the area it covers.
+  double max_range = 0;
   int threads = 2;
 };
 
