@@ -3,7 +3,9 @@
 // - faces (rigid boxy classes: cars): the box is moved so that its sides facing the sensor touch the visible faces
 //   (keeping the predicted length and width), and its top is set from the highest returns (keeping the bottom; far
 //   away, where the beams are sparse, within the slack the beam spacing leaves).
-//   Faces hidden from the sensor keep the network's estimate.
+//   Faces hidden from the sensor keep the network's estimate, except with hidden_midpoint: along an axis whose two
+//   faces are both hidden (a car seen end-on), the visible face spans the car, and its returns centre the box; and
+//   with grow, a size grows (the visible face staying) to hold returns seen beyond the far face.
 // - centroid (small classes: pedestrians, cyclists): the box centre is put at the centroid of its returns moved away
 //   from the sensor by a per-class offset (the visible surface lies in front of the centre; measured on training
 //   data), twice, so that the returns are re-selected around the moved box.
