@@ -113,8 +113,8 @@ def table3(inter_name):
              " | mean L2 mAP | **mean L2 mAPH** |", "| --- " * (2 + 2 * len(CLASSES) + 1) + "|"]
     kitti = ["| stages | Car 3D @0.7 | Pedestrian 3D @0.5 | Cyclist 3D @0.5 | Car BEV @0.7 | mean L2 mAPH |",
              "| --- | --- | --- | --- | --- | --- |"]
-    mot = ["| stages | class | MOTA | MOTP | IDSW | IDSW per 100 GT tracks | HOTA | DetA | AssA | id stability % |",
-           "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+    mot = ["| stages | class | MOTA | MOTP | IDSW | IDSW per 100 GT tracks | HOTA | DetA | AssA | id stability % | "
+           "MOTA / IDSW / HOTA within 48 m |", "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     for label, name in rows:
         m = metrics(name)
         cells = []
@@ -126,12 +126,15 @@ def table3(inter_name):
         kitti.append("| " + " | ".join([label] + ["%.2f" % m["kitti.%s.3d.R40.moderate" % c] for c in CLASSES] + [
             "%.2f" % m["kitti.Car.bev.R40.moderate"], "%.2f" % m["waymo.mean.L2.APH"]]) + " |")
         if "mot.Car.MOTA" in m:
+            near_file = "out/heldout/%s/eval_48m/metrics.json" % name
+            near = json.load(open(near_file)) if os.path.exists(near_file) else None
             for c in CLASSES:
                 p = "mot.%s." % c
                 tracks = max(1.0, m["mot_detail.%s.GT_tracks" % c])
-                mot.append("| %s | %s | %.2f | %.2f | %d | %.1f | %.2f | %.2f | %.2f | %.1f |" % (
+                within = "%.2f / %d / %.2f" % (near[p + "MOTA"], near[p + "IDSW"], near[p + "HOTA"]) if near else "-"
+                mot.append("| %s | %s | %.2f | %.2f | %d | %.1f | %.2f | %.2f | %.2f | %.1f | %s |" % (
                     label, c, m[p + "MOTA"], m[p + "MOTP"], m[p + "IDSW"], 100.0 * m[p + "IDSW"] / tracks,
-                    m[p + "HOTA"], m[p + "DetA"], m[p + "AssA"], m.get(p + "IdStability", float("nan"))))
+                    m[p + "HOTA"], m[p + "DetA"], m[p + "AssA"], m.get(p + "IdStability", float("nan")), within))
     lines = waymo + [""] + kitti + [""] + mot
     print("\n".join(lines))
     write_between("table3-sim", lines)
