@@ -6,12 +6,13 @@
 #   3. runs each on the validation set (`ret3d detect` then `ret3d eval`) and keeps the better one (mean of the
 #      three classes' 3D AP R40 moderate);
 #   4. gives the better head the rest of the budget: a second stage (config/detector/lwd3d_<head>_stage2.yaml,
-#      12 more epochs from its weights, both threads; the anchor head's adds IoU-quality channels, which start fresh),
-#      installed as models/lwd3d/detector.pt when it validates better. Its inference options (box voting, IoU-score
-#      power) were chosen once with scripts/tune_inference.sh and are written in that YAML.
+#      12 more epochs from its weights, both threads; the anchor head's adds IoU-quality channels, which start fresh)
+#      and a third (lwd3d_<head>_stage3.yaml, 6 more epochs at half the rate), each kept when it validates better;
+#      the best is installed as models/lwd3d/detector.pt. The inference options (box voting, IoU-score power, point
+#      refinement) were chosen on the tuning set and are written in the last stage's YAML.
 # Resumable: run it again after a stop and it continues from the last checkpoint (every 5 minutes); finished steps
-# are skipped. About 75-90 minutes on the idle 2-core machine for the two heads, then 30-45 minutes for the second
-# stage. Work goes to data/ and out/train_default/.
+# are skipped. On the idle 2-core machine about 55 minutes for the two heads, 40 for the second stage and 20 for the
+# third (112 in all; on a host slowed by other load, up to twice that). Work goes to data/ and out/train_default/.
 set -eo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$(pwd)
@@ -67,20 +68,28 @@ for head in center anchor; do
 done
 model="$OUT/$best.pt"
 
-# Second stage for the better head (the heads are compared at the same budget first): the rest of the 2-hour budget
-# goes to it, 12 more epochs from its weights with a warm restart of the schedule, both threads.
-if [ -f "config/detector/lwd3d_${best}_stage2.yaml" ]; then
-  if [ ! -f "$OUT/${best}_stage2.done" ]; then
-    start=$(date +%s)
+# Further stages for the better head (the heads are compared at the same budget first), with the rest of the 2-hour
+# budget, both threads: config/detector/lwd3d_<head>_stage2.yaml (12 more epochs from its weights, a warm restart of
+# the schedule), then lwd3d_<head>_stage3.yaml (6 more from stage 2's, half the rate, another seed). A stage's model
+# is installed when it validates better than the best so far.
+stage() {  # stage-name init-model
+  local name="${best_head}_$1"
+  [ -f "config/detector/lwd3d_$name.yaml" ] || return 0
+  if [ ! -f "$OUT/$name.done" ]; then
+    local t0
+    t0=$(date +%s)
     ret3d train detector --data data/sim_train_urban data/sim_train_highway \
-      --config "config/detector/lwd3d_${best}_stage2.yaml" --init "$OUT/$best.pt" --out "$OUT/${best}_stage2.pt" \
-      --threads 2 --resume >"$OUT/train_${best}_stage2.log" 2>&1
-    touch "$OUT/${best}_stage2.done"
-    echo "second stage took $(( ($(date +%s) - start) / 60 )) min (this run)"
+      --config "config/detector/lwd3d_$name.yaml" --init "$2" --out "$OUT/$name.pt" \
+      --threads 2 --resume >"$OUT/train_$name.log" 2>&1
+    touch "$OUT/$name.done"
+    echo "$1 took $(( ($(date +%s) - t0) / 60 )) min (this run)"
   fi
-  ap=$(validate "${best}_stage2" "$OUT/${best}_stage2.pt")
-  echo "$best head after the second stage: mean 3D AP R40 moderate on the validation set $ap"
-  if better "$ap" "$best_ap"; then model="$OUT/${best}_stage2.pt"; best="$best head, second stage"; best_ap=$ap; fi
-fi
+  ap=$(validate "$name" "$OUT/$name.pt")
+  echo "$best_head head after $1: mean 3D AP R40 moderate on the validation set $ap"
+  if better "$ap" "$best_ap"; then model="$OUT/$name.pt"; best="$best_head head, $1"; best_ap=$ap; fi
+}
+best_head=$best
+stage stage2 "$OUT/$best_head.pt"
+[ -f "$OUT/${best_head}_stage2.pt" ] && stage stage3 "$OUT/${best_head}_stage2.pt"
 cp "$model" models/lwd3d/detector.pt
 echo "default detector: $model ($best; validation mean 3D AP R40 moderate $best_ap) -> models/lwd3d/detector.pt"
