@@ -32,7 +32,7 @@ case "$metrics" in *mot*)
     >"$OUT/eval_48m.log" 2>&1 ;;
 esac
 python3 - "$OUT" <<'PY'
-import json, sys
+import json, os, sys
 out = sys.argv[1]
 m = json.load(open(out + "/eval/metrics.json"))
 classes = ("Car", "Pedestrian", "Cyclist")
@@ -46,7 +46,6 @@ print("mean        %8.2f %8.2f %8.2f %9.2f %9.2f" % (sum(m["kitti.%s.3d.R40.mode
 for k in sorted(m):
     if k.startswith("mot.") and (k.endswith(".MOTA") or k.endswith(".IDSW") or k.endswith(".HOTA") or k.endswith(".IdStability")):
         print("%s %.2f" % (k, m[k]))
-import os
 if os.path.exists(out + "/eval_48m/metrics.json"):
     m48 = json.load(open(out + "/eval_48m/metrics.json"))
     for c in classes:

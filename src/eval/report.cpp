@@ -429,8 +429,7 @@ std::vector<std::string> writeReport(const std::string& dir, const EvalReport& r
     if (o.max_range > 0)
       md << "Only boxes within " << fmt(o.max_range) << " m of the sensor (BEV) are evaluated, ground truth and "
          << "predictions alike. ";
-    md
-       << "MOTA, MOTP, HOTA, DetA, AssA in percent; IDSW and FRAG are counts; MT / ML in percent of ground-truth "
+    md << "MOTA, MOTP, HOTA, DetA, AssA in percent; IDSW and FRAG are counts; MT / ML in percent of ground-truth "
           "tracks (tracked > 80 % / < 20 % of their frames). Definitions as TrackEval. "
        << r.mot->num_sequences << " sequences; " << r.mot->removed_on_ignore
        << " predictions on ignored ground truth (Van, Person_sitting) removed.\n\n"
