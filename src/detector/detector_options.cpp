@@ -203,6 +203,9 @@ void readInference(MapReader r, InferenceOptions* o) {
     p.get("height", &o->point_refine.height);
     p.get("hidden_midpoint", &o->point_refine.hidden_midpoint);
     p.get("grow", &o->point_refine.grow);
+    p.get("heading_search_deg", &o->point_refine.heading_search_deg);
+    p.get("heading_step_deg", &o->point_refine.heading_step_deg);
+    p.get("heading_min_points", &o->point_refine.heading_min_points);
     p.finish();
     try {
       o->point_refine.validate();

@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "ret3d/core/geometry.h"
+
 namespace ret3d {
 
 void PointRefineOptions::validate() const {
@@ -28,6 +30,9 @@ void PointRefineOptions::validate() const {
   if (!(ground_clearance >= 0 && ground_clearance < 5)) fail("ground_clearance", "must lie in [0, 5) m");
   if (!(max_shift >= 0 && max_shift < 5)) fail("max_shift", "must lie in [0, 5) m");
   if (min_points < 1) fail("min_points", "must be >= 1");
+  if (!(heading_search_deg >= 0 && heading_search_deg < 45)) fail("heading_search_deg", "must lie in [0, 45) deg");
+  if (!(heading_step_deg > 0 && heading_step_deg <= 10)) fail("heading_step_deg", "must lie in (0, 10] deg");
+  if (heading_min_points < 3) fail("heading_min_points", "must be >= 3");
 }
 
 namespace {
@@ -114,8 +119,57 @@ void refineTop(const PointRefineOptions& o, std::vector<double>* z, Box* b) {
   b->z = bottom + 0.5 * b->height;
 }
 
+// The heading that best fits the outline of the returns within half a length (plus the margin) of the centre, from
+// the network's heading +- heading_search_deg (see heading_search_deg in the header).
+double fitHeading(const PointCloud& cloud, const CellIndex& index, const PointRefineOptions& o, const Box& b) {
+  constexpr std::size_t kMaxReturns = 400;  // more are thinned evenly: the score needs the outline, not every return
+  constexpr double kCloseness = 0.02;       // d0 of the criterion (m): about the returns' range noise
+  const double radius = 0.5 * b.length + o.margin, z_lo = b.bottom() + o.ground_clearance;
+  const double z_hi = b.top() + 2 * o.margin;
+  std::vector<double> x, y;
+  index.visit(b.x, b.y, radius, [&](std::size_t i) {
+    const Point& p = cloud.points[i];
+    const double dx = p.x - b.x, dy = p.y - b.y;
+    if (p.z > z_lo && p.z < z_hi && dx * dx + dy * dy < radius * radius) x.push_back(dx), y.push_back(dy);
+  });
+  if (static_cast<int>(x.size()) < o.heading_min_points) return b.yaw;
+  const std::size_t stride = (x.size() + kMaxReturns - 1) / kMaxReturns;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < x.size(); i += stride, ++n) x[n] = x[i], y[n] = y[i];
+  x.resize(n), y.resize(n);
+
+  std::vector<double> c1(n), c2(n);
+  // Distance of each return to the face of its axis that the returns hug (the one nearer them in sum of squares).
+  auto toFace = [&](std::vector<double>* c) {
+    const auto [lo, hi] = std::minmax_element(c->begin(), c->end());
+    const double cmin = *lo, cmax = *hi;
+    double to_min = 0, to_max = 0;
+    for (double v : *c) to_min += (v - cmin) * (v - cmin), to_max += (cmax - v) * (cmax - v);
+    for (double& v : *c) v = to_min <= to_max ? v - cmin : cmax - v;
+  };
+  const double step = o.heading_step_deg * M_PI / 180.0;
+  const int steps = static_cast<int>(std::floor(o.heading_search_deg / o.heading_step_deg));
+  // The best score's first run of steps: every return within d0 of a face scores the same, so the score is flat
+  // over a few steps around the true heading, whose middle is taken.
+  int best_lo = 0, best_hi = 0;
+  double best_score = -1;
+  for (int k = -steps; k <= steps; ++k) {
+    const double yaw = b.yaw + k * step, c = std::cos(yaw), s = std::sin(yaw);
+    for (std::size_t i = 0; i < n; ++i) c1[i] = x[i] * c + y[i] * s, c2[i] = -x[i] * s + y[i] * c;
+    toFace(&c1), toFace(&c2);
+    double score = 0;
+    for (std::size_t i = 0; i < n; ++i) score += 1.0 / std::max(std::min(c1[i], c2[i]), kCloseness);
+    if (score > best_score * (1 + 1e-9))
+      best_score = score, best_lo = best_hi = k;
+    else if (score >= best_score * (1 - 1e-9) && k == best_hi + 1)
+      best_hi = k;
+  }
+  return wrapAngle(b.yaw + 0.5 * (best_lo + best_hi) * step);
+}
+
 bool refineFaces(const PointCloud& cloud, const CellIndex& index, const PointRefineOptions& o, BoxReturns* r,
                  Box* b) {
+  if (o.heading_search_deg > 0) b->yaw = fitHeading(cloud, index, o, *b);
   r->collect(cloud, index, *b, o.margin, o.ground_clearance, b->top() + 2 * o.margin);
   if (static_cast<int>(r->u.size()) < o.min_points) return false;
   const double c = std::cos(b->yaw), s = std::sin(b->yaw);

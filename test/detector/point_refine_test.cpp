@@ -126,6 +126,34 @@ TEST(PointRefine, GrowsASizeToHoldTheReturnsOfASideSeenWhole) {
   EXPECT_DOUBLE_EQ(boxes[0].length, shorter.length);
 }
 
+TEST(PointRefine, FitsTheHeadingToTheOutlineOfTheReturns) {
+  // Seen obliquely (an L of rear and side), the network's heading 12 degrees off: the fitted heading is within half
+  // a degree, and the faces then put the box in place.
+  const Box truth = carBox(14, 8, 0.4);
+  const PointCloud cloud = visibleFaces(truth);
+  PointRefineOptions o = carsOnly();
+  o.heading_search_deg = 20;
+  o.heading_step_deg = 0.5;
+  Box off = moved(truth, 0.2, -0.15);
+  off.yaw += 0.21;
+  std::vector<Box> boxes = {off};
+  refineBoxesFromPoints(cloud, &boxes, o);
+  EXPECT_NEAR(boxes[0].yaw, truth.yaw, 0.5 * M_PI / 180);
+  EXPECT_NEAR(boxes[0].x, truth.x, 0.05);
+  EXPECT_NEAR(boxes[0].y, truth.y, 0.05);
+  // Seen end-on (one straight face), off the other way: the face fixes the heading too.
+  const Box end_on = carBox(16, 0.3, 0.05);
+  Box end_off = end_on;
+  end_off.yaw -= 0.15;
+  boxes = {end_off};
+  refineBoxesFromPoints(visibleFaces(end_on), &boxes, o);
+  EXPECT_NEAR(boxes[0].yaw, end_on.yaw, 0.5 * M_PI / 180);
+  // Without the search, the network's heading stays.
+  boxes = {off};
+  refineBoxesFromPoints(cloud, &boxes, carsOnly());
+  EXPECT_DOUBLE_EQ(boxes[0].yaw, off.yaw);
+}
+
 TEST(PointRefine, SetsTheTopFromTheHighestReturnsAndKeepsTheBottom) {
   const Box truth = carBox(8, -7, -1.2, 4.0, 1.7, 1.62);
   PointCloud cloud = visibleFaces(truth);
@@ -273,6 +301,11 @@ TEST(PointRefine, OptionsAreReadFromYamlAndMistakesRefused) {
   const auto m = detectorOptionsFromYaml("inference:\n  point_refine: {faces: [Car], hidden_midpoint: true, grow: true}\n");
   EXPECT_TRUE(m.inference.point_refine.hidden_midpoint);
   EXPECT_TRUE(m.inference.point_refine.grow);
+  EXPECT_DOUBLE_EQ(m.inference.point_refine.heading_search_deg, 0);
+  const auto f = detectorOptionsFromYaml(
+      "inference:\n  point_refine: {faces: [Car], heading_search_deg: 15, heading_step_deg: 0.5}\n");
+  EXPECT_DOUBLE_EQ(f.inference.point_refine.heading_search_deg, 15);
+  EXPECT_DOUBLE_EQ(f.inference.point_refine.heading_step_deg, 0.5);
   EXPECT_FALSE(detectorOptionsFromYaml("inference: {}").inference.point_refine.enabled());
   const auto h = detectorOptionsFromYaml("inference: {heading_from_velocity: {Pedestrian: 0.3}}");
   ASSERT_EQ(h.inference.heading_from_velocity.size(), 1u);
@@ -281,7 +314,8 @@ TEST(PointRefine, OptionsAreReadFromYamlAndMistakesRefused) {
   EXPECT_THROW(detectorOptionsFromYaml("inference: {heading_from_velocity: {Walker: 1}}"), std::runtime_error);
   for (const std::string bad : {"faces: [Truck]", "centroid: {Truck: 0.1}", "centroid: {Car: 0.1}, faces: [Car]",
                                 "centroid: {Pedestrian: 3}", "quantile: 0", "quantile: 1.5", "min_points: 0", "margn: 0.3",
-                                "max_shift: -1"}) {
+                                "max_shift: -1", "heading_search_deg: 50",
+                                "heading_step_deg: 0", "heading_min_points: 2"}) {
     try {
       detectorOptionsFromYaml("inference:\n  point_refine: {" + bad + "}\n");
       FAIL() << bad << " was accepted";

@@ -6,6 +6,7 @@
 //   Faces hidden from the sensor keep the network's estimate, except with hidden_midpoint: along an axis whose two
 //   faces are both hidden (a car seen end-on), the visible face spans the car, and its returns centre the box; and
 //   with grow, a size grows (the visible face staying) to hold returns seen beyond the far face.
+//   With heading_search_deg, a car's heading is first fitted to the outline of its returns (an L-shape fit).
 // - centroid (small classes: pedestrians, cyclists): the box centre is put at the centroid of its returns moved away
 //   from the sensor by a per-class offset (the visible surface lies in front of the centre; measured on training
 //   data), twice, so that the returns are re-selected around the moved box.
@@ -40,6 +41,13 @@ struct PointRefineOptions {
   bool hidden_midpoint = false;
   // faces: a size grows (keeping the visible face) to hold the returns seen beyond the far face.
   bool grow = false;
+  // faces: the heading fitted to the returns' outline before the faces are placed: headings within this angle of
+  // the network's (deg, below 45 so that length stays length) are scored by the closeness criterion of Zhang et al.
+  // (2017, "Efficient L-shape fitting for vehicle detection using laser scanners"): the returns should lie close to
+  // one of the two faces of each axis. 0 = the network's heading is kept.
+  double heading_search_deg = 0.0;
+  double heading_step_deg = 1.0;
+  int heading_min_points = 10;     // fewer returns: the network's heading is kept
 
   bool enabled() const { return !faces.empty() || !centroid.empty(); }
   // Throws std::invalid_argument naming the field when a value is out of range.
