@@ -206,6 +206,17 @@ void readInference(MapReader r, InferenceOptions* o) {
     p.get("heading_search_deg", &o->point_refine.heading_search_deg);
     p.get("heading_step_deg", &o->point_refine.heading_step_deg);
     p.get("heading_min_points", &o->point_refine.heading_min_points);
+    {
+      std::map<std::string, std::vector<double>> weights;
+      for (const auto& [c, w] : o->point_refine.score_calibration) weights[className(c)] = w;
+      p.get("score_calibration", &weights);
+      o->point_refine.score_calibration.clear();
+      for (const auto& [name, w] : weights) {
+        const auto c = classFromName(name);
+        if (!c) p.fail(p.full("score_calibration"), "unknown class '" + name + "' (Car, Pedestrian, Cyclist)");
+        o->point_refine.score_calibration.emplace_back(*c, w);
+      }
+    }
     p.finish();
     try {
       o->point_refine.validate();

@@ -33,6 +33,14 @@ void PointRefineOptions::validate() const {
   if (!(heading_search_deg >= 0 && heading_search_deg < 45)) fail("heading_search_deg", "must lie in [0, 45) deg");
   if (!(heading_step_deg > 0 && heading_step_deg <= 10)) fail("heading_step_deg", "must lie in (0, 10] deg");
   if (heading_min_points < 3) fail("heading_min_points", "must be >= 3");
+  for (const auto& [c, w] : score_calibration) {
+    if (c == ObjectClass::Unknown) fail("score_calibration", "must name Car, Pedestrian or Cyclist");
+    if (w.size() != kCalibrationFeatures)
+      fail("score_calibration", std::string("needs ") + std::to_string(kCalibrationFeatures) + " weights for " +
+                                    className(c) + ", not " + std::to_string(w.size()));
+    for (double v : w)
+      if (!std::isfinite(v)) fail("score_calibration", std::string("weights of ") + className(c) + " must be finite");
+  }
 }
 
 namespace {
@@ -236,10 +244,23 @@ bool refineCentroid(const PointCloud& cloud, const CellIndex& index, const Point
   return moved;
 }
 
+// The calibrated score of a box held by n returns (score_calibration in the header).
+double calibratedScore(const std::vector<double>& w, double score, std::size_t n, double range) {
+  const double s = std::clamp(score, 1e-4, 1 - 1e-4), logit = std::log(s / (1 - s));
+  const double log_n = std::log1p(static_cast<double>(n)), r = range / 40.0;
+  const double z = w[0] + w[1] * logit + w[2] * log_n + w[3] * r + w[4] * log_n * r + w[5] * logit * log_n;
+  return 1.0 / (1.0 + std::exp(-z));
+}
+
 }  // namespace
 
 std::size_t refineBoxesFromPoints(const PointCloud& cloud, std::vector<Box>* boxes, const PointRefineOptions& o) {
-  // The face classes' mode (1) or the centroid offset (2) of a box; 0 = not refined.
+  auto calibration = [&](const Box& b) -> const std::vector<double>* {
+    for (const auto& [c, w] : o.score_calibration)
+      if (c == b.label) return &w;
+    return nullptr;
+  };
+  // The face classes' mode (1), the centroid offset (2) of a box, or only its score calibrated (3); 0 = none.
   auto mode = [&](const Box& b, double* offset) {
     if (!(b.length > 0 && b.width > 0 && b.height > 0 && std::isfinite(b.x) && std::isfinite(b.y) &&
           std::isfinite(b.z) && std::isfinite(b.yaw)))
@@ -247,7 +268,7 @@ std::size_t refineBoxesFromPoints(const PointCloud& cloud, std::vector<Box>* box
     if (std::find(o.faces.begin(), o.faces.end(), b.label) != o.faces.end()) return 1;
     for (const auto& [c, off] : o.centroid)
       if (c == b.label) return *offset = off, 2;
-    return 0;
+    return calibration(b) ? 3 : 0;
   };
   double x0 = 1e300, y0 = 1e300, z0 = 1e300, x1 = -1e300, y1 = -1e300, z1 = -1e300, offset = 0;
   for (const Box& b : *boxes) {
@@ -266,6 +287,10 @@ std::size_t refineBoxesFromPoints(const PointCloud& cloud, std::vector<Box>* box
     const int m = mode(b, &offset);
     if (m == 1 && refineFaces(cloud, index, o, &returns, &b)) ++changed;
     if (m == 2 && refineCentroid(cloud, index, o, offset, &returns, &b)) ++changed;
+    if (const auto* w = m ? calibration(b) : nullptr) {
+      returns.collect(cloud, index, b, o.margin, o.ground_clearance, b.top() + o.margin);
+      b.score = static_cast<float>(calibratedScore(*w, b.score, returns.u.size(), std::hypot(b.x, b.y)));
+    }
   }
   return changed;
 }

@@ -288,6 +288,28 @@ TEST(HeadingFromVelocity, MovingBoxesOfTheListedClassesFaceTheirVelocity) {
   EXPECT_EQ(headingFromVelocity(&boxes, {}), 0u);
 }
 
+TEST(PointRefine, CalibratedScoresRiseWithTheReturnsThatHoldTheBox) {
+  // Two cars scored alike by the network, at the same range: one seen whole, one (behind a wall) without a return.
+  // score = sigmoid(w . [1, logit s, log(1 + n), r / 40, log(1 + n) r / 40, logit s log(1 + n)]).
+  const Box seen = carBox(12, 6, 0.3), unseen = carBox(-12, -6, 0.3);
+  const PointCloud cloud = visibleFaces(seen);
+  PointRefineOptions o;
+  o.score_calibration = {{ObjectClass::Car, {-2.0, 1.0, 0.5, 0.0, 0.0, 0.0}}};
+  std::vector<Box> boxes = {seen, unseen};
+  boxes[0].score = boxes[1].score = 0.7f;
+  EXPECT_EQ(refineBoxesFromPoints(cloud, &boxes, o), 0u);  // nothing moved: only the scores are calibrated
+  const double logit = std::log(0.7 / 0.3), n = static_cast<double>(cloud.size());
+  EXPECT_NEAR(boxes[0].score, 1 / (1 + std::exp(-(-2.0 + logit + 0.5 * std::log1p(n)))), 1e-5);
+  EXPECT_NEAR(boxes[1].score, 1 / (1 + std::exp(-(-2.0 + logit))), 1e-5);
+  EXPECT_GT(boxes[0].score, boxes[1].score);
+  EXPECT_DOUBLE_EQ(boxes[0].x, seen.x);
+  // Other classes keep their scores.
+  std::vector<Box> people = {seen};
+  people[0].label = ObjectClass::Pedestrian;
+  refineBoxesFromPoints(cloud, &people, o);
+  EXPECT_FLOAT_EQ(people[0].score, 0.9f);
+}
+
 TEST(PointRefine, OptionsAreReadFromYamlAndMistakesRefused) {
   const auto o = detectorOptionsFromYaml(
       "inference:\n  point_refine: {faces: [Car, Cyclist], quantile: 0.8, centroid: {Pedestrian: 0.1}}\n");
@@ -307,6 +329,13 @@ TEST(PointRefine, OptionsAreReadFromYamlAndMistakesRefused) {
   EXPECT_DOUBLE_EQ(f.inference.point_refine.heading_search_deg, 15);
   EXPECT_DOUBLE_EQ(f.inference.point_refine.heading_step_deg, 0.5);
   EXPECT_FALSE(detectorOptionsFromYaml("inference: {}").inference.point_refine.enabled());
+  const auto g = detectorOptionsFromYaml(
+      "inference:\n  point_refine: {faces: [Car], score_calibration: {Car: [-1, 2, 0.5, 0.1, 0, 0.2]}}\n");
+  ASSERT_EQ(g.inference.point_refine.score_calibration.size(), 1u);
+  EXPECT_EQ(g.inference.point_refine.score_calibration[0].first, ObjectClass::Car);
+  EXPECT_DOUBLE_EQ(g.inference.point_refine.score_calibration[0].second[5], 0.2);
+  EXPECT_TRUE(detectorOptionsFromYaml("inference: {point_refine: {score_calibration: {Car: [0, 1, 0, 0, 0, 0]}}}")
+                  .inference.point_refine.enabled());
   const auto h = detectorOptionsFromYaml("inference: {heading_from_velocity: {Pedestrian: 0.3}}");
   ASSERT_EQ(h.inference.heading_from_velocity.size(), 1u);
   EXPECT_DOUBLE_EQ(h.inference.heading_from_velocity[0].second, 0.3);
@@ -315,7 +344,9 @@ TEST(PointRefine, OptionsAreReadFromYamlAndMistakesRefused) {
   for (const std::string bad : {"faces: [Truck]", "centroid: {Truck: 0.1}", "centroid: {Car: 0.1}, faces: [Car]",
                                 "centroid: {Pedestrian: 3}", "quantile: 0", "quantile: 1.5", "min_points: 0", "margn: 0.3",
                                 "max_shift: -1", "heading_search_deg: 50",
-                                "heading_step_deg: 0", "heading_min_points: 2"}) {
+                                "heading_step_deg: 0", "heading_min_points: 2",
+                                "score_calibration: {Car: [1, 2]}", "score_calibration: {Truck: [0, 1, 0, 0, 0, 0]}",
+                                "score_calibration: {Car: [0, .nan, 0, 0, 0, 0]}", "score_calibration: [1, 2]"}) {
     try {
       detectorOptionsFromYaml("inference:\n  point_refine: {" + bad + "}\n");
       FAIL() << bad << " was accepted";

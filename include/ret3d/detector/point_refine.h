@@ -10,6 +10,7 @@
 // - centroid (small classes: pedestrians, cyclists): the box centre is put at the centroid of its returns moved away
 //   from the sensor by a per-class offset (the visible surface lies in front of the centre; measured on training
 //   data), twice, so that the returns are re-selected around the moved box.
+// - score_calibration: the score of a refined box re-estimated from the returns that hold it.
 #pragma once
 
 #include <vector>
@@ -48,8 +49,15 @@ struct PointRefineOptions {
   double heading_search_deg = 0.0;
   double heading_step_deg = 1.0;
   int heading_min_points = 10;     // fewer returns: the network's heading is kept
+  // Score calibration, per class: after the refinement a box's score becomes sigmoid(w . f) with the features
+  // f = [1, logit(score), log(1 + n), r / 40, log(1 + n) r / 40, logit(score) log(1 + n)], n the returns in the box
+  // (its footprint grown by margin, from ground_clearance above its bottom to margin above its top) and r its range
+  // (m). The network scores a box from a blurred grid; how many returns hold it says how well its box can fit
+  // them. The weights are fitted on labelled data by scripts/fit_score_calibration.py. Empty = scores as they are.
+  std::vector<std::pair<ObjectClass, std::vector<double>>> score_calibration;
+  static constexpr std::size_t kCalibrationFeatures = 6;
 
-  bool enabled() const { return !faces.empty() || !centroid.empty(); }
+  bool enabled() const { return !faces.empty() || !centroid.empty() || !score_calibration.empty(); }
   // Throws std::invalid_argument naming the field when a value is out of range.
   void validate() const;
 };
