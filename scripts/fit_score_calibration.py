@@ -4,10 +4,12 @@
 Reads the boxes of one class that `ret3d detect --stages base` wrote for a labelled KITTI tracking-layout folder (run
 with the calibration off), counts the returns that hold each box exactly as the detector does, and fits a logistic
 regression of "the box overlaps a true one by at least --iou in 3D" on the features
-  [1, logit(score), log(1 + n), r / 40, log(1 + n) r / 40, logit(score) log(1 + n)].
+  [1, logit(score), log(1 + n), r / 40, log(1 + n) r / 40, logit(score) log(1 + n), a, a^2, e]
+(n returns, r range, a = |sin(heading - bearing)|, e the returns' median distance to the nearest face).
 Prints the weights as the YAML line to paste under inference.point_refine.score_calibration.
 
   scripts/fit_score_calibration.py --gt data/sim_relation_urban --pred out/calib/pred [--class Car] [--iou 0.7]
+      [--no-shape]
 """
 import argparse
 import glob
@@ -96,9 +98,12 @@ def iou_3d(a, b):
     return v / (a[3] * a[4] * a[5] + b[3] * b[4] * b[5] - v)
 
 
+MAX_RESIDUAL = 0.5  # PointRefineOptions::kMaxResidual
+
+
 def returns_holding(points, b, cam_to_lidar, margin, clearance):
-    """n and range as the detector counts them: returns within the footprint grown by margin, from clearance above
-    the bottom to margin above the top (LiDAR frame)."""
+    """n, range, aspect and residual as the detector computes them: the returns within the footprint grown by
+    margin, from clearance above the bottom to margin above the top (LiDAR frame)."""
     x, y, z, h, w, l, ry = b[:7]
     c = cam_to_lidar @ np.array([x, y, z, 1.0])  # the centre of the bottom face
     yaw = -ry - math.pi / 2
@@ -107,13 +112,19 @@ def returns_holding(points, b, cam_to_lidar, margin, clearance):
     v = -dx * math.sin(yaw) + dy * math.cos(yaw)
     inside = ((np.abs(u) < l / 2 + margin) & (np.abs(v) < w / 2 + margin) & (points[:, 2] > c[2] + clearance) &
               (points[:, 2] < c[2] + h + margin))
-    return int(inside.sum()), math.hypot(c[0], c[1])
+    n = int(inside.sum())
+    residual = MAX_RESIDUAL
+    if n >= 3:
+        d = np.sort(np.minimum(np.abs(np.abs(u[inside]) - l / 2), np.abs(np.abs(v[inside]) - w / 2)))
+        residual = min(residual, float(d[(n - 1) // 2]))
+    aspect = abs(math.sin(yaw - math.atan2(c[1], c[0])))
+    return n, math.hypot(c[0], c[1]), aspect, residual
 
 
-def features(score, n, r):
+def features(score, n, r, aspect, residual):
     s = min(max(score, 1e-4), 1 - 1e-4)
     logit, log_n, rr = math.log(s / (1 - s)), math.log1p(n), r / 40.0
-    return [1.0, logit, log_n, rr, log_n * rr, logit * log_n]
+    return [1.0, logit, log_n, rr, log_n * rr, logit * log_n, aspect, aspect * aspect, residual]
 
 
 def fit_logistic(x, y, l2=1e-3, iterations=50):
@@ -139,6 +150,8 @@ def main():
     ap.add_argument('--iou', type=float, default=0.7, help='3D IoU a box must reach to count as good')
     ap.add_argument('--margin', type=float, default=0.3, help='point_refine.margin of the detector config')
     ap.add_argument('--ground-clearance', type=float, default=0.3, help='point_refine.ground_clearance')
+    ap.add_argument('--no-shape', action='store_true',
+                    help='fit only the first six weights (score, returns, range); a, a^2 and e get 0')
     args = ap.parse_args()
     root = os.path.join(args.gt, 'training') if os.path.isdir(os.path.join(args.gt, 'training')) else args.gt
     files = sorted(glob.glob(os.path.join(args.pred, '*.txt')))
@@ -155,13 +168,14 @@ def main():
             for b in boxes:
                 best = max([iou_3d(g, b) for g in truth.get(frame, []) if math.hypot(g[0] - b[0], g[2] - b[2]) < 5],
                            default=0.0)
-                n, r = returns_holding(points, b, cam_to_lidar, args.margin, args.ground_clearance)
-                rows.append(features(b[7], n, r))
+                rows.append(features(b[7], *returns_holding(points, b, cam_to_lidar, args.margin, args.ground_clearance)))
                 labels.append(1.0 if best >= args.iou else 0.0)
     x, y = np.array(rows), np.array(labels)
     if len(y) < 50 or y.min() == y.max():
         sys.exit('fit_score_calibration: %d boxes of %s, %d good: too few to fit' % (len(y), args.cls, int(y.sum())))
-    w = fit_logistic(x, y)
+    used = 6 if args.no_shape else x.shape[1]
+    w = np.zeros(x.shape[1])
+    w[:used] = fit_logistic(x[:, :used], y)
     before = 1 / (1 + np.exp(-x[:, 1]))
     after = 1 / (1 + np.exp(-x @ w))
     print('%d %s boxes from %d sequences, %.1f %% with 3D IoU >= %.2f' % (len(y), args.cls, len(files),

@@ -244,11 +244,24 @@ bool refineCentroid(const PointCloud& cloud, const CellIndex& index, const Point
   return moved;
 }
 
-// The calibrated score of a box held by n returns (score_calibration in the header).
-double calibratedScore(const std::vector<double>& w, double score, std::size_t n, double range) {
-  const double s = std::clamp(score, 1e-4, 1 - 1e-4), logit = std::log(s / (1 - s));
-  const double log_n = std::log1p(static_cast<double>(n)), r = range / 40.0;
-  const double z = w[0] + w[1] * logit + w[2] * log_n + w[3] * r + w[4] * log_n * r + w[5] * logit * log_n;
+// The calibrated score of box `b` from its returns `r` (score_calibration in the header).
+double calibratedScore(const std::vector<double>& w, const Box& b, BoxReturns* r) {
+  const std::size_t n = r->u.size();
+  double residual = PointRefineOptions::kMaxResidual;
+  if (n >= 3) {
+    // Each return's distance to the nearer face of the box (reusing z as scratch), then their median.
+    const double hl = 0.5 * b.length, hw = 0.5 * b.width;
+    for (std::size_t i = 0; i < n; ++i)
+      r->z[i] = std::min(std::abs(std::abs(r->u[i]) - hl), std::abs(std::abs(r->v[i]) - hw));
+    residual = std::min(residual, quantileOf(&r->z, 0.5));
+  }
+  const double s = std::clamp(static_cast<double>(b.score), 1e-4, 1 - 1e-4), logit = std::log(s / (1 - s));
+  const double log_n = std::log1p(static_cast<double>(n)), range = std::hypot(b.x, b.y) / 40.0;
+  const double aspect = std::abs(std::sin(b.yaw - std::atan2(b.y, b.x)));
+  const double f[PointRefineOptions::kCalibrationFeatures] = {
+      1, logit, log_n, range, log_n * range, logit * log_n, aspect, aspect * aspect, residual};
+  double z = 0;
+  for (std::size_t k = 0; k < PointRefineOptions::kCalibrationFeatures; ++k) z += w[k] * f[k];
   return 1.0 / (1.0 + std::exp(-z));
 }
 
@@ -289,7 +302,7 @@ std::size_t refineBoxesFromPoints(const PointCloud& cloud, std::vector<Box>* box
     if (m == 2 && refineCentroid(cloud, index, o, offset, &returns, &b)) ++changed;
     if (const auto* w = m ? calibration(b) : nullptr) {
       returns.collect(cloud, index, b, o.margin, o.ground_clearance, b.top() + o.margin);
-      b.score = static_cast<float>(calibratedScore(*w, b.score, returns.u.size(), std::hypot(b.x, b.y)));
+      b.score = static_cast<float>(calibratedScore(*w, b, &returns));
     }
   }
   return changed;

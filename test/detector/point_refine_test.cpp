@@ -289,20 +289,29 @@ TEST(HeadingFromVelocity, MovingBoxesOfTheListedClassesFaceTheirVelocity) {
 }
 
 TEST(PointRefine, CalibratedScoresRiseWithTheReturnsThatHoldTheBox) {
-  // Two cars scored alike by the network, at the same range: one seen whole, one (behind a wall) without a return.
-  // score = sigmoid(w . [1, logit s, log(1 + n), r / 40, log(1 + n) r / 40, logit s log(1 + n)]).
+  // Two cars scored alike by the network, at the same range: one seen whole, its returns 5 cm inside its faces, one
+  // (behind a wall) without a return. score = sigmoid(w . [1, logit s, log(1 + n), r / 40, log(1 + n) r / 40,
+  // logit s log(1 + n), a, a^2, e]) with a = |sin(heading - bearing)| and e the returns' median distance to a face.
   const Box seen = carBox(12, 6, 0.3), unseen = carBox(-12, -6, 0.3);
-  const PointCloud cloud = visibleFaces(seen);
+  const PointCloud cloud = visibleFaces(seen, 0.05);
   PointRefineOptions o;
-  o.score_calibration = {{ObjectClass::Car, {-2.0, 1.0, 0.5, 0.0, 0.0, 0.0}}};
+  o.score_calibration = {{ObjectClass::Car, {-2.0, 1.0, 0.5, 0.0, 0.0, 0.0, 0.3, 0.0, -4.0}}};
   std::vector<Box> boxes = {seen, unseen};
   boxes[0].score = boxes[1].score = 0.7f;
   EXPECT_EQ(refineBoxesFromPoints(cloud, &boxes, o), 0u);  // nothing moved: only the scores are calibrated
   const double logit = std::log(0.7 / 0.3), n = static_cast<double>(cloud.size());
-  EXPECT_NEAR(boxes[0].score, 1 / (1 + std::exp(-(-2.0 + logit + 0.5 * std::log1p(n)))), 1e-5);
-  EXPECT_NEAR(boxes[1].score, 1 / (1 + std::exp(-(-2.0 + logit))), 1e-5);
+  const double aspect = std::abs(std::sin(0.3 - std::atan2(6.0, 12.0)));
+  auto sigmoid = [](double z) { return 1 / (1 + std::exp(-z)); };
+  EXPECT_NEAR(boxes[0].score, sigmoid(-2.0 + logit + 0.5 * std::log1p(n) + 0.3 * aspect - 4.0 * 0.05), 1e-4);
+  EXPECT_NEAR(boxes[1].score, sigmoid(-2.0 + logit + 0.3 * aspect - 4.0 * PointRefineOptions::kMaxResidual), 1e-5);
   EXPECT_GT(boxes[0].score, boxes[1].score);
   EXPECT_DOUBLE_EQ(boxes[0].x, seen.x);
+  // Returns 20 cm outside the faces fit the box worse than returns 5 cm inside them.
+  const PointCloud loose = visibleFaces(seen, -0.2);
+  std::vector<Box> off = {seen};
+  off[0].score = 0.7f;
+  refineBoxesFromPoints(loose, &off, o);
+  EXPECT_LT(off[0].score, boxes[0].score);
   // Other classes keep their scores.
   std::vector<Box> people = {seen};
   people[0].label = ObjectClass::Pedestrian;
@@ -330,11 +339,11 @@ TEST(PointRefine, OptionsAreReadFromYamlAndMistakesRefused) {
   EXPECT_DOUBLE_EQ(f.inference.point_refine.heading_step_deg, 0.5);
   EXPECT_FALSE(detectorOptionsFromYaml("inference: {}").inference.point_refine.enabled());
   const auto g = detectorOptionsFromYaml(
-      "inference:\n  point_refine: {faces: [Car], score_calibration: {Car: [-1, 2, 0.5, 0.1, 0, 0.2]}}\n");
+      "inference:\n  point_refine: {faces: [Car], score_calibration: {Car: [-1, 2, 0.5, 0.1, 0, 0.2, 0, 0, -3]}}\n");
   ASSERT_EQ(g.inference.point_refine.score_calibration.size(), 1u);
   EXPECT_EQ(g.inference.point_refine.score_calibration[0].first, ObjectClass::Car);
-  EXPECT_DOUBLE_EQ(g.inference.point_refine.score_calibration[0].second[5], 0.2);
-  EXPECT_TRUE(detectorOptionsFromYaml("inference: {point_refine: {score_calibration: {Car: [0, 1, 0, 0, 0, 0]}}}")
+  EXPECT_DOUBLE_EQ(g.inference.point_refine.score_calibration[0].second[8], -3);
+  EXPECT_TRUE(detectorOptionsFromYaml("inference: {point_refine: {score_calibration: {Car: [0, 1, 0, 0, 0, 0, 0, 0, 0]}}}")
                   .inference.point_refine.enabled());
   const auto h = detectorOptionsFromYaml("inference: {heading_from_velocity: {Pedestrian: 0.3}}");
   ASSERT_EQ(h.inference.heading_from_velocity.size(), 1u);
@@ -345,8 +354,8 @@ TEST(PointRefine, OptionsAreReadFromYamlAndMistakesRefused) {
                                 "centroid: {Pedestrian: 3}", "quantile: 0", "quantile: 1.5", "min_points: 0", "margn: 0.3",
                                 "max_shift: -1", "heading_search_deg: 50",
                                 "heading_step_deg: 0", "heading_min_points: 2",
-                                "score_calibration: {Car: [1, 2]}", "score_calibration: {Truck: [0, 1, 0, 0, 0, 0]}",
-                                "score_calibration: {Car: [0, .nan, 0, 0, 0, 0]}", "score_calibration: [1, 2]"}) {
+                                "score_calibration: {Car: [1, 2]}", "score_calibration: {Truck: [0, 1, 0, 0, 0, 0, 0, 0, 0]}",
+                                "score_calibration: {Car: [0, .nan, 0, 0, 0, 0, 0, 0, 0]}", "score_calibration: [1, 2]"}) {
     try {
       detectorOptionsFromYaml("inference:\n  point_refine: {" + bad + "}\n");
       FAIL() << bad << " was accepted";

@@ -10,7 +10,7 @@
 // - centroid (small classes: pedestrians, cyclists): the box centre is put at the centroid of its returns moved away
 //   from the sensor by a per-class offset (the visible surface lies in front of the centre; measured on training
 //   data), twice, so that the returns are re-selected around the moved box.
-// - score_calibration: the score of a refined box re-estimated from the returns that hold it.
+// - score_calibration: the score of a refined box re-estimated from the returns that hold it and how they fit it.
 #pragma once
 
 #include <vector>
@@ -50,12 +50,18 @@ struct PointRefineOptions {
   double heading_step_deg = 1.0;
   int heading_min_points = 10;     // fewer returns: the network's heading is kept
   // Score calibration, per class: after the refinement a box's score becomes sigmoid(w . f) with the features
-  // f = [1, logit(score), log(1 + n), r / 40, log(1 + n) r / 40, logit(score) log(1 + n)], n the returns in the box
-  // (its footprint grown by margin, from ground_clearance above its bottom to margin above its top) and r its range
-  // (m). The network scores a box from a blurred grid; how many returns hold it says how well its box can fit
-  // them. The weights are fitted on labelled data by scripts/fit_score_calibration.py. Empty = scores as they are.
+  // f = [1, logit(score), log(1 + n), r / 40, log(1 + n) r / 40, logit(score) log(1 + n), a, a^2, e]:
+  // - n the returns in the box (its footprint grown by margin, from ground_clearance above its bottom to margin
+  //   above its top);
+  // - r its range (m); a = |sin(heading - bearing)|, 0 seen end-on, 1 seen side-on;
+  // - e the median distance of those returns to the nearest face of the box (m, at most kMaxResidual; kMaxResidual
+  //   with fewer than 3 returns).
+  // The network scores a box from a blurred grid; how many returns hold the refined box, and how closely they lie
+  // on its faces, say how well it fits them. The weights are fitted on labelled data by
+  // scripts/fit_score_calibration.py. Empty = scores as they are.
   std::vector<std::pair<ObjectClass, std::vector<double>>> score_calibration;
-  static constexpr std::size_t kCalibrationFeatures = 6;
+  static constexpr std::size_t kCalibrationFeatures = 9;
+  static constexpr double kMaxResidual = 0.5;
 
   bool enabled() const { return !faces.empty() || !centroid.empty() || !score_calibration.empty(); }
   // Throws std::invalid_argument naming the field when a value is out of range.
