@@ -72,6 +72,8 @@ struct ModelConfig {
 struct InferenceOptions {
   std::string model_path;      // empty: the network is freshly initialised (tests, training)
   int threads = 2;             // torch intra-op threads and BEV workers
+  // Candidates below this score are dropped before NMS. A calibrated class (point_refine.score_calibration) is
+  // re-scored after NMS, so its published scores may fall below it: downstream thresholds (the tracker's) see those.
   float score_threshold = 0.3f;
   int max_candidates = 500;    // per class before NMS
   int max_detections = 200;    // after NMS
