@@ -112,9 +112,10 @@ void readClasses(MapReader& r, const std::string& key, std::vector<ObjectClass>*
   }
 }
 
-// A map from class names to numbers under `key`, e.g. centroid: {Pedestrian: 0.1}.
-void readClassValues(MapReader& r, const std::string& key, std::vector<std::pair<ObjectClass, double>>* out) {
-  std::map<std::string, double> values;
+// A map from class names to values under `key`, e.g. centroid: {Pedestrian: 0.1} or score_calibration: {Car: [...]}.
+template <typename V>
+void readClassValues(MapReader& r, const std::string& key, std::vector<std::pair<ObjectClass, V>>* out) {
+  std::map<std::string, V> values;
   for (const auto& [c, v] : *out) values[className(c)] = v;
   r.get(key, &values);
   out->clear();
@@ -206,17 +207,7 @@ void readInference(MapReader r, InferenceOptions* o) {
     p.get("heading_search_deg", &o->point_refine.heading_search_deg);
     p.get("heading_step_deg", &o->point_refine.heading_step_deg);
     p.get("heading_min_points", &o->point_refine.heading_min_points);
-    {
-      std::map<std::string, std::vector<double>> weights;
-      for (const auto& [c, w] : o->point_refine.score_calibration) weights[className(c)] = w;
-      p.get("score_calibration", &weights);
-      o->point_refine.score_calibration.clear();
-      for (const auto& [name, w] : weights) {
-        const auto c = classFromName(name);
-        if (!c) p.fail(p.full("score_calibration"), "unknown class '" + name + "' (Car, Pedestrian, Cyclist)");
-        o->point_refine.score_calibration.emplace_back(*c, w);
-      }
-    }
+    readClassValues(p, "score_calibration", &o->point_refine.score_calibration);
     p.finish();
     try {
       o->point_refine.validate();
