@@ -65,7 +65,7 @@ Detections Detector::detect(const PointCloud& current, const PointCloud* previou
   timings_.network_ms = msSince(t0);
 
   t0 = std::chrono::steady_clock::now();
-  const BevGeometry& g = options_.model.geometry;
+  const BevGeometry g = options_.inferenceGeometry();
   std::vector<Box> candidates = model.head().decode(out, 0, g, options_.inference);
   timings_.decode_ms = msSince(t0);
 

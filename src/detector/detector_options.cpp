@@ -50,9 +50,20 @@ void ModelConfig::validate() const {
   if (!(sweep_interval > 0)) fail("sweep_interval must be positive");
 }
 
+BevGeometry DetectorOptions::inferenceGeometry() const {
+  BevGeometry g = model.geometry;
+  if (inference.grid_extent.size() == 4) {
+    g.x_min = inference.grid_extent[0];
+    g.x_max = inference.grid_extent[1];
+    g.y_min = inference.grid_extent[2];
+    g.y_max = inference.grid_extent[3];
+  }
+  return g;
+}
+
 BevEncoderOptions DetectorOptions::bevOptions() const {
   BevEncoderOptions o;
-  o.geometry = model.geometry;
+  o.geometry = inferenceGeometry();
   o.density_norm = model.density_norm;
   o.threads = inference.threads;
   return o;
@@ -186,6 +197,7 @@ void readInference(MapReader r, InferenceOptions* o) {
   r.get("nms_voting_iou", &o->nms_voting_iou);
   r.get("iou_score_power", &o->iou_score_power);
   readClassValues(r, "heading_from_velocity", &o->heading_from_velocity);
+  r.get("grid_extent", &o->grid_extent);
   for (const auto& [c, speed] : o->heading_from_velocity)
     if (!(speed >= 0)) r.fail(r.full("heading_from_velocity"), "speeds must be >= 0 m/s");
   {
@@ -282,6 +294,18 @@ DetectorOptions detectorOptionsFromYaml(const std::string& yaml_text, const std:
     o.model.validate();
   } catch (const std::invalid_argument& e) {
     throw std::runtime_error(origin + ": " + e.what());
+  }
+  const std::vector<double>& ext = o.inference.grid_extent;
+  if (!ext.empty()) {
+    const std::string key = origin + ": inference.grid_extent: ";
+    if (ext.size() != 4) throw std::runtime_error(key + "expected [x_min, x_max, y_min, y_max]");
+    ModelConfig m = o.model;
+    m.geometry = o.inferenceGeometry();
+    try {
+      m.validate();
+    } catch (const std::invalid_argument& e) {
+      throw std::runtime_error(key + e.what());
+    }
   }
   return o;
 }

@@ -94,6 +94,12 @@ std::unique_ptr<DetectorModel> DetectorModel::extend(const std::string& path, co
   auto from = load(path);
   ModelConfig base = config;
   base.anchor.iou_quality = from->config().anchor.iou_quality;
+  // The network is fully convolutional: a start on a grid of another extent (same cells) keeps every weight.
+  const BevGeometry& fg = from->config().geometry;
+  base.geometry.x_min = fg.x_min;
+  base.geometry.x_max = fg.x_max;
+  base.geometry.y_min = fg.y_min;
+  base.geometry.y_max = fg.y_max;
   const auto diffs = diffModelConfigs(from->config(), base);
   if (!diffs.empty() || (from->config().anchor.iou_quality && !config.anchor.iou_quality)) {
     std::string msg = path + ": cannot start the configured model from this file:";

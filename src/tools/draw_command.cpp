@@ -133,7 +133,7 @@ int runDraw(DrawArgs a) {
     OfflinePipeline p(a.pipeline);
     const Detections d = p.run(&cloud, nullptr, Eigen::Isometry3d::Identity(), {}, 0.0, Eigen::Isometry3d::Identity());
     dets = d.boxes;
-    const BevGeometry& g = p.detector()->options().model.geometry;
+    const BevGeometry g = p.detector()->options().inferenceGeometry();
     view.x_min = g.x_min;
     view.x_max = g.x_max;
     view.y_min = g.y_min;

@@ -55,6 +55,28 @@ TEST(DetectorOptions, MistakesAreRefusedNamingTheFileAndKey) {
   EXPECT_THROW(detectorOptionsFromYaml("model: {bev: {x_min: 0, x_max: 0}}"), std::runtime_error);
 }
 
+TEST(DetectorOptions, TheInferenceGridExtentIsReadAndChecked) {
+  const auto o = detectorOptionsFromYaml("inference: {grid_extent: [-80, 80, -48, 48]}\n");
+  EXPECT_EQ(o.model.geometry.width(), 384);  // the model's grid is unchanged
+  EXPECT_EQ(o.inferenceGeometry().width(), 640);
+  EXPECT_EQ(o.inferenceGeometry().height(), 384);
+  EXPECT_EQ(o.bevOptions().geometry.width(), 640);
+  EXPECT_DOUBLE_EQ(o.inferenceGeometry().resolution, o.model.geometry.resolution);
+  EXPECT_EQ(detectorOptionsFromYaml("{}").inferenceGeometry().width(), 384);
+  auto refused = [](const std::string& yaml, const std::string& words) {
+    try {
+      detectorOptionsFromYaml(yaml);
+      ADD_FAILURE() << "accepted: " << yaml;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("inference.grid_extent"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+    }
+  };
+  refused("inference: {grid_extent: [-80, 80]}", "[x_min, x_max, y_min, y_max]");
+  refused("inference: {grid_extent: [-45, 45, -48, 48]}", "divisible");  // 360 cells: not a multiple of 16
+  refused("inference: {grid_extent: [80, -80, -48, 48]}", "x_max must exceed x_min");
+}
+
 TEST(DetectorOptions, ModelConfigRoundTripsAndDiffsReadably) {
   ModelConfig m;
   m.head = HeadType::Anchor;

@@ -138,6 +138,51 @@ TEST(ModelFile, AModelThatAddsIoUQualityStartsFromTheWeightsOfOneWithout) {
   }
 }
 
+TEST(ModelFile, AModelCoversAWiderGridThanItWasTrainedOn) {
+  test::TempDir dir;
+  const std::string path = dir / "m.ret3d";
+  torch::manual_seed(5);
+  nn::DetectorModel(smallModel(HeadType::Anchor)).save(path);  // a +-16 m grid
+
+  // Inference: the file's weights on a 64 x 32 m grid; boxes come from the whole of it.
+  DetectorOptions o;
+  o.model = smallModel(HeadType::Anchor);
+  o.inference.model_path = path;
+  o.inference.score_threshold = 0.0f;
+  o.inference.grid_extent = {-32, 32, -16, 16};
+  Detector d(o);
+  EXPECT_EQ(d.options().inferenceGeometry().width(), 256);
+  EXPECT_EQ(d.options().inferenceGeometry().height(), 128);
+  PointCloud cloud = someCloud(7);
+  for (auto& p : cloud.points) p.x *= 2;
+  const Detections det = d.detect(cloud, nullptr, Eigen::Isometry3d::Identity());
+  ASSERT_FALSE(det.boxes.empty());
+  double far = 0;
+  for (const Box& b : det.boxes) {
+    far = std::max(far, std::abs(b.x));
+    EXPECT_LE(std::abs(b.x), 34.0);
+    EXPECT_LE(std::abs(b.y), 18.0);
+  }
+  EXPECT_GT(far, 20.0) << "no box beyond the trained grid";
+
+  // Training: a model of the wider grid starts from every weight of the file.
+  ModelConfig wide = smallModel(HeadType::Anchor);
+  wide.geometry.x_min = -32, wide.geometry.x_max = 32;
+  std::vector<std::string> fresh;
+  auto started = nn::DetectorModel::extend(path, wide, &fresh);
+  EXPECT_TRUE(fresh.empty());
+  EXPECT_EQ(started->config().geometry.width(), 256);
+  auto file = nn::DetectorModel::load(path);
+  started->net->eval();
+  torch::NoGradGuard ng;
+  const auto x = torch::rand({1, 6, 128, 256});
+  const auto a = file->forward(x), b = started->forward(x);
+  for (const auto& [stride, out] : a.head) EXPECT_TRUE(torch::equal(b.head.at(stride), out)) << "stride " << stride;
+  // Another cell size is another network input: refused.
+  wide.geometry.resolution = 0.5;
+  EXPECT_THROW(nn::DetectorModel::extend(path, wide), ModelFileError);
+}
+
 TEST(ModelFile, TruncatedOrCorruptFilesAreRefused) {
   test::TempDir dir;
   const std::string path = dir / "m.ret3d";

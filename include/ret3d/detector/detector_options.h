@@ -87,6 +87,10 @@ struct InferenceOptions {
   PointRefineOptions point_refine;
   // Per class, the speed (m/s) from which a box takes the heading of its velocity (headingFromVelocity); empty = off.
   std::vector<std::pair<ObjectClass, double>> heading_from_velocity;
+  // The grid the network runs on, [x_min, x_max, y_min, y_max] in metres; empty = the model's. The network is fully
+  // convolutional (its attention's positions come from a convolution), so a trained model may cover more ground
+  // than it was trained on, at a cost proportional to the area; the resolution and the heights stay the model's.
+  std::vector<double> grid_extent;
 };
 
 struct TrainOptions {
@@ -126,6 +130,8 @@ struct DetectorOptions {
   TrainOptions train;
 
   BevEncoderOptions bevOptions() const;
+  // The model's geometry with inference.grid_extent applied (what the encoder and the decoding use).
+  BevGeometry inferenceGeometry() const;
 };
 
 // Reads a YAML file; every key is optional (defaults above); an unknown key, a wrong type or an invalid value

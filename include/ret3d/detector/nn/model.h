@@ -28,7 +28,8 @@ class DetectorModel {
   // listing every difference.
   static std::unique_ptr<DetectorModel> load(const std::string& path, const ModelConfig* expected = nullptr);
   // A model of `config` started from the weights of a model file whose config differs at most by outputs that
-  // `config` adds (anchor.iou_quality turned on): every tensor of the file is copied, a head layer that gained output
+  // `config` adds (anchor.iou_quality turned on) and by the grid's extent (the cells, heights and network the same:
+  // it is fully convolutional): every tensor of the file is copied, a head layer that gained output
   // channels gets the file's in its leading ones. `fresh` (optional) receives the names of tensors not (fully)
   // copied. Throws ModelFileError for any other difference.
   static std::unique_ptr<DetectorModel> extend(const std::string& path, const ModelConfig& config,
