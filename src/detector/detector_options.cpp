@@ -61,6 +61,14 @@ BevGeometry DetectorOptions::inferenceGeometry() const {
   return g;
 }
 
+void DetectorOptions::validateGridExtent() const {
+  if (inference.grid_extent.empty()) return;
+  if (inference.grid_extent.size() != 4) throw std::invalid_argument("expected [x_min, x_max, y_min, y_max]");
+  ModelConfig m = model;
+  m.geometry = inferenceGeometry();
+  m.validate();
+}
+
 BevEncoderOptions DetectorOptions::bevOptions() const {
   BevEncoderOptions o;
   o.geometry = inferenceGeometry();
@@ -295,17 +303,10 @@ DetectorOptions detectorOptionsFromYaml(const std::string& yaml_text, const std:
   } catch (const std::invalid_argument& e) {
     throw std::runtime_error(origin + ": " + e.what());
   }
-  const std::vector<double>& ext = o.inference.grid_extent;
-  if (!ext.empty()) {
-    const std::string key = origin + ": inference.grid_extent: ";
-    if (ext.size() != 4) throw std::runtime_error(key + "expected [x_min, x_max, y_min, y_max]");
-    ModelConfig m = o.model;
-    m.geometry = o.inferenceGeometry();
-    try {
-      m.validate();
-    } catch (const std::invalid_argument& e) {
-      throw std::runtime_error(key + e.what());
-    }
+  try {
+    o.validateGridExtent();
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(origin + ": inference.grid_extent: " + e.what());
   }
   return o;
 }

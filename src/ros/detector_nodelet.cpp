@@ -54,7 +54,8 @@ class DetectorNodelet : public StageNodelet<sensor_msgs::PointCloud2> {
     for (int k = 0; k < 3; ++k) detector_->detect(cloud, &cloud, Eigen::Isometry3d::Identity());
     NODELET_INFO_STREAM("detector warmed up in "
                         << std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()
-                        << " s (3 synthetic scans of 120k points)");
+                        << " s (3 synthetic scans of 120k points); grid "
+                        << detector_->options().inferenceGeometry().describe());
   }
 
   // dynamic_reconfigure (cfg/Detector.cfg): the score threshold and the NMS IoU change between clouds. The server

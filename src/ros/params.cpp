@@ -120,6 +120,21 @@ int ParamReader::integer(const std::string& name, int fallback, int min, int max
   return x;
 }
 
+std::vector<double> ParamReader::numbers(const std::string& name, const std::vector<double>& fallback) const {
+  XmlRpc::XmlRpcValue v;
+  if (!nh_.getParam(name, v)) return fallback;
+  const auto refuse = [&] { return ParamError("parameter " + fullName(name) + " = " + show(v) + ": must be a list of numbers"); };
+  if (v.getType() != XmlRpc::XmlRpcValue::TypeArray) throw refuse();
+  std::vector<double> out;
+  for (int i = 0; i < v.size(); ++i) {
+    XmlRpc::XmlRpcValue& e = v[i];
+    if (e.getType() == XmlRpc::XmlRpcValue::TypeDouble) out.push_back(static_cast<double>(e));
+    else if (e.getType() == XmlRpc::XmlRpcValue::TypeInt) out.push_back(static_cast<int>(e));
+    else throw refuse();
+  }
+  return out;
+}
+
 bool ParamReader::boolean(const std::string& name, bool fallback) const {
   XmlRpc::XmlRpcValue v;
   if (!nh_.getParam(name, v)) return fallback;
@@ -167,6 +182,13 @@ DetectorNodeletParams loadDetectorNodeletParams(const ros::NodeHandle& private_n
   // The model file's point refinement (boxes fitted to the raw returns) can only be switched off here.
   if (!p.boolean("point_refine", true)) inf.point_refine = PointRefineOptions();
   inf.max_detections = p.integer("max_detections", inf.max_detections, 1, 100000);
+  // The ground the network covers (a trained model runs on a wider grid at a cost in proportion to its area).
+  inf.grid_extent = p.numbers("grid_extent", inf.grid_extent);
+  try {
+    params.detector.validateGridExtent();
+  } catch (const std::invalid_argument& e) {
+    throw ParamError("parameter " + p.fullName("grid_extent") + ": " + e.what());
+  }
   const std::string scaling =
       p.choice("intensity_scaling", "auto", {"auto", "datatype", "observed_max", "fixed"});
   params.cloud.intensity_scaling = scaling == "auto"           ? IntensityScaling::Auto

@@ -307,6 +307,31 @@ TEST_F(DetectorNodeletTest, ModelThatDoesNotFitTheConfigIsRefused) {
   ros::param::del("/bad_detector");
 }
 
+TEST_F(DetectorNodeletTest, TheGridExtentWidensTheGroundCoveredAndAWrongOneIsRefused) {
+  // The model is for +-24 m; ~grid_extent runs it over 96 x 48 m.
+  ros::param::set("/wide_detector/model_path", tmp_ / "detector.pt");
+  ros::param::set("/wide_detector/config", tmp_ / "small.yaml");
+  ros::param::set("/wide_detector/threads", 1);
+  ros::param::set("/wide_detector/grid_extent", std::vector<double>{-48, 48, -24, 24});
+  {
+    nodelet::Loader loader(false);
+    EXPECT_TRUE(test::loadNodelet(loader, "/wide_detector", "ret3d/DetectorNodelet")) << log_.all();
+    EXPECT_FALSE(log_.find({"detector warmed up", "x [-48, 48] y [-24, 24]"}).empty()) << log_.all();
+    loader.unload("/wide_detector");
+  }
+  ros::param::del("/wide_detector");
+  // Two numbers, or an extent that is not a whole number of the network's coarsest cells (8 m here): refused.
+  for (const auto& extent : {std::vector<double>{-48, 48}, std::vector<double>{-30, 30, -24, 24}}) {
+    ros::param::set("/bad_detector/model_path", tmp_ / "detector.pt");
+    ros::param::set("/bad_detector/config", tmp_ / "small.yaml");
+    ros::param::set("/bad_detector/grid_extent", extent);
+    nodelet::Loader loader(false);
+    EXPECT_FALSE(test::loadNodelet(loader, "/bad_detector", "ret3d/DetectorNodelet"));
+    EXPECT_FALSE(log_.find({"refuses to start", "/bad_detector/grid_extent"}).empty()) << log_.all();
+    ros::param::del("/bad_detector");
+  }
+}
+
 TEST_F(DetectorNodeletTest, MissingModelIsRefused) {
   ros::param::set("/bad_detector/model_path", tmp_ / "missing.pt");
   ros::param::set("/bad_detector/config", tmp_ / "small.yaml");

@@ -132,6 +132,9 @@ struct DetectorOptions {
   BevEncoderOptions bevOptions() const;
   // The model's geometry with inference.grid_extent applied (what the encoder and the decoding use).
   BevGeometry inferenceGeometry() const;
+  // Throws std::invalid_argument unless inference.grid_extent is empty or [x_min, x_max, y_min, y_max] of a grid the
+  // network can run on (whole cells, divisible by the coarsest stride).
+  void validateGridExtent() const;
 };
 
 // Reads a YAML file; every key is optional (defaults above); an unknown key, a wrong type or an invalid value

@@ -38,6 +38,7 @@ class ParamReader {
   double number(const std::string& name, double fallback, double min, double max) const;  // inclusive range
   int integer(const std::string& name, int fallback, int min, int max) const;
   bool boolean(const std::string& name, bool fallback) const;
+  std::vector<double> numbers(const std::string& name, const std::vector<double>& fallback) const;  // a list
   bool has(const std::string& name) const { return nh_.hasParam(name); }
   // The full name of a parameter, for messages ("/ret3d_tracker/max_age").
   std::string fullName(const std::string& name) const { return nh_.resolveName(name); }
