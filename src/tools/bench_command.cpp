@@ -235,6 +235,7 @@ int benchNodelets(const BenchArgs& a) {
   o.detector_config = p.detector_config;
   o.tracker_config = p.tracker_config;
   o.score_threshold = p.score_threshold;
+  o.grid_extent = p.grid_extent;
   o.threads = p.threads;
   o.warmup = a.warmup;
   o.max_frames = a.max_frames;
@@ -329,6 +330,7 @@ CommandRegistrar reg("bench", "time the pipeline: through the nodelets on a bag,
   app.add_option("--tracker-config", p.tracker_config,
                  "tracker YAML (default: built-in values; --bag: the one config/ret3d.yaml names)");
   app.add_option("--score-threshold", p.score_threshold, "detector score threshold (default: the model's; --bag: config/ret3d.yaml's)");
+  addGridExtentOption(app, &p.grid_extent);
   app.add_option("--stages", a->stages, "comma-separated stages in order, starting with base")->capture_default_str();
   app.add_option("--threads", p.threads, "CPU threads for libtorch")->capture_default_str();
   app.add_option("--warmup", a->warmup, "untimed runs first (--bag: clouds left out of the statistics)")->capture_default_str();

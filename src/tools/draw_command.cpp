@@ -265,6 +265,7 @@ CommandRegistrar reg("draw", "a bird's-eye-view PNG of a scan with ground truth 
   app.add_option("--detector-model", p.detector_model, "run this detector model file (overrides --models)");
   app.add_option("--detector-config", p.detector_config, "detector YAML for inference options");
   app.add_option("--score-threshold", p.score_threshold, "minimum score (detector or --pred; default: the model's)");
+  addGridExtentOption(app, &p.grid_extent);
   app.add_option("--threads", p.threads, "CPU threads for libtorch")->capture_default_str();
   app.add_option("--view", a->view, "around: the detector's grid (else 96 m x 96 m) around the sensor; front: 0-70 m "
                  "ahead, +-40 m")->capture_default_str();

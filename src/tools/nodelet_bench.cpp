@@ -551,6 +551,7 @@ int runNodeletBench(const NodeletBenchOptions& o) {
     ros::param::set("/ret3d_detector/config", o.detector_config);
     ros::param::set("/ret3d_detector/threads", o.threads);
     if (o.score_threshold >= 0) ros::param::set("/ret3d_detector/score_threshold", o.score_threshold);
+    if (!o.grid_extent.empty()) ros::param::set("/ret3d_detector/grid_extent", o.grid_extent);
     ros::param::set("/ret3d_intra/model_path", o.intra_model);
     ros::param::set("/ret3d_intra/threads", o.threads);
     if (!o.tracker_config.empty()) ros::param::set("/ret3d_tracker/tracker_config", o.tracker_config);

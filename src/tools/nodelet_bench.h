@@ -23,6 +23,7 @@ struct NodeletBenchOptions {
   std::string tracker_config;       // empty: the one config/ret3d.yaml names
   std::string params;               // the nodelets' YAML (default: $(find ret3d)/config/ret3d.yaml)
   double score_threshold = -1;      // >= 0: overrides ret3d_detector/score_threshold
+  std::vector<double> grid_extent;  // non-empty: sets ret3d_detector/grid_extent
   int threads = 2;                  // libtorch threads of each learned stage (the launch file's `threads`)
   int manager_threads = 4;          // the manager's callback threads (the launch file's `manager_threads`)
   bool markers = true;              // load the MarkerNodelet too, as the launch file does (only with InterRM)

@@ -6,6 +6,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <CLI/CLI.hpp>
+
 #include "ret3d/detector/model_file.h"
 #include "ret3d/tracking/tracker_options.h"
 
@@ -54,6 +56,14 @@ std::vector<std::string> parseStages(const std::string& list) {
   return out;
 }
 
+void addGridExtentOption(CLI::App& app, std::vector<double>* extent) {
+  app.add_option("--grid-extent", *extent,
+                 "run the detector over this grid, x_min,x_max,y_min,y_max in m (e.g. --grid-extent=-80,80,-48,48; "
+                 "default: the model's); the cost grows with the area")
+      ->delimiter(',')
+      ->expected(4);
+}
+
 OfflinePipeline::OfflinePipeline(const PipelineConfig& c) : stages_(c.stages) {
   std::ostringstream desc;
   desc << "stages";
@@ -65,9 +75,17 @@ OfflinePipeline::OfflinePipeline(const PipelineConfig& c) : stages_(c.stages) {
     DetectorOptions o = detectorOptionsForModel(path, c.detector_config);
     o.inference.threads = c.threads;
     if (c.score_threshold >= 0) o.inference.score_threshold = c.score_threshold;
+    if (!c.grid_extent.empty()) {
+      o.inference.grid_extent = c.grid_extent;
+      try {
+        o.validateGridExtent();
+      } catch (const std::invalid_argument& e) {
+        throw std::runtime_error(std::string("--grid-extent: ") + e.what());
+      }
+    }
     detector_ = std::make_unique<Detector>(o);
     desc << "; detector " << path << " (" << headTypeName(o.model.head) << " head, " << detector_->parameterCount()
-         << " parameters, score >= " << o.inference.score_threshold << ")";
+         << " parameters, score >= " << o.inference.score_threshold << ", grid " << o.inferenceGeometry().describe() << ")";
   }
   if (has(stages_, "intra")) {
     relation::IntraRMOptions o;

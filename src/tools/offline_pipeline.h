@@ -16,6 +16,10 @@
 #include "ret3d/relation/intra_rm.h"
 #include "ret3d/train/inter_trainer.h"
 
+namespace CLI {
+class App;
+}
+
 namespace ret3d {
 namespace tools {
 
@@ -26,8 +30,12 @@ struct PipelineConfig {
   std::string detector_config;      // YAML for the detector's inference options (default: those it was trained with)
   std::string tracker_config;       // tracker YAML (default: the built-in values of config/tracker.yaml)
   double score_threshold = -1;      // >= 0: overrides the detector's inference.score_threshold
+  std::vector<double> grid_extent;  // non-empty: overrides inference.grid_extent [x_min, x_max, y_min, y_max]
   int threads = 2;
 };
+
+// The --grid-extent option of the commands that run the detector (x_min,x_max,y_min,y_max in metres).
+void addGridExtentOption(CLI::App& app, std::vector<double>* extent);
 
 // Parses "base,intra,track" (or "none"): throws naming an unknown stage or a misplaced one.
 std::vector<std::string> parseStages(const std::string& list);

@@ -103,6 +103,19 @@ TEST_F(BenchCommand, WithoutRelationStagesTheTrackerReadsTheDetections) {
   EXPECT_NE(r.output.find("stamp to /tracked"), std::string::npos) << r.output;
 }
 
+TEST_F(BenchCommand, GridExtentWidensTheDetectorsGroundAndAWrongOneIsAClearError) {
+  // In process over the tiny sequence: the +-24 m model timed on a 96 x 48 m grid.
+  const CommandResult wide =
+      bench({"--data", tmp_.path(), "--stages", "base", "--warmup", "1", "--min-runs", "3", "--grid-extent=-48,48,-24,24"});
+  ASSERT_EQ(wide.exit_code, 0) << wide.output;
+  EXPECT_NE(wide.output.find("grid x [-48, 48] y [-24, 24]"), std::string::npos) << wide.output;
+  // 60 m is not a whole number of the network's coarsest cells (8 m here).
+  const CommandResult odd = bench({"--data", tmp_.path(), "--stages", "base", "--grid-extent=-30,30,-24,24"});
+  EXPECT_NE(odd.exit_code, 0);
+  EXPECT_NE(odd.output.find("--grid-extent: "), std::string::npos) << odd.output;
+  EXPECT_NE(odd.output.find("divisible"), std::string::npos) << odd.output;
+}
+
 TEST_F(BenchCommand, MissingBagOrModelIsAClearError) {
   const CommandResult no_bag = bench({"--bag", tmp_ / "missing.bag"});
   EXPECT_NE(no_bag.exit_code, 0);
