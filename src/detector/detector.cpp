@@ -24,6 +24,7 @@ struct Detector::Impl {
 
 Detector::Detector(const DetectorOptions& options) : options_(options), impl_(std::make_unique<Impl>()) {
   options_.model.validate();
+  options_.validateGridExtent();
   torch::set_num_threads(options_.inference.threads);
   if (options_.inference.model_path.empty()) {
     impl_->model = std::make_shared<nn::DetectorModel>(options_.model);
@@ -38,6 +39,7 @@ Detector::Detector(const DetectorOptions& options, std::shared_ptr<nn::DetectorM
     : options_(options), impl_(std::make_unique<Impl>()) {
   const auto diffs = diffModelConfigs(model->config(), options_.model);
   if (!diffs.empty()) throw std::invalid_argument("Detector: the model does not match the options: " + diffs.front());
+  options_.validateGridExtent();
   impl_->model = std::move(model);
   impl_->encoder = std::make_unique<BevEncoder>(options_.bevOptions());
 }
@@ -65,7 +67,7 @@ Detections Detector::detect(const PointCloud& current, const PointCloud* previou
   timings_.network_ms = msSince(t0);
 
   t0 = std::chrono::steady_clock::now();
-  const BevGeometry g = options_.inferenceGeometry();
+  const BevGeometry& g = impl_->encoder->geometry();  // the grid just encoded (inference.grid_extent applied)
   std::vector<Box> candidates = model.head().decode(out, 0, g, options_.inference);
   timings_.decode_ms = msSince(t0);
 

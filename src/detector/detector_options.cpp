@@ -205,9 +205,9 @@ void readInference(MapReader r, InferenceOptions* o) {
   r.get("nms_voting_iou", &o->nms_voting_iou);
   r.get("iou_score_power", &o->iou_score_power);
   readClassValues(r, "heading_from_velocity", &o->heading_from_velocity);
-  r.get("grid_extent", &o->grid_extent);
   for (const auto& [c, speed] : o->heading_from_velocity)
     if (!(speed >= 0)) r.fail(r.full("heading_from_velocity"), "speeds must be >= 0 m/s");
+  r.get("grid_extent", &o->grid_extent);  // checked against the model once it is read (detectorOptionsFromYaml)
   {
     MapReader p = r.child("point_refine");
     readClasses(p, "faces", &o->point_refine.faces);

@@ -28,7 +28,8 @@ struct DetectorTimings {
 class Detector {
  public:
   // Loads options.inference.model_path, refusing a file whose model differs from options.model (the message lists
-  // what differs); with an empty path the network is freshly initialised (tests). Sets torch's thread count.
+  // what differs); with an empty path the network is freshly initialised (tests). Sets torch's thread count. Throws
+  // std::invalid_argument for an inference.grid_extent the network cannot run on (validateGridExtent).
   explicit Detector(const DetectorOptions& options);
   // Wraps an existing model (training: validation with the model being trained); the options' model part must match.
   Detector(const DetectorOptions& options, std::shared_ptr<nn::DetectorModel> model);
