@@ -122,6 +122,16 @@ std::vector<double> kittiThresholds(std::vector<double> v, int num_gt) {
   return t;
 }
 
+std::vector<double> kittiExactSamples(const std::vector<double>& recall, const std::vector<double>& precision) {
+  std::vector<double> out(kKittiSamplePoints, 0.0);
+  for (int k = 0; k < kKittiSamplePoints; ++k) {
+    const double r = static_cast<double>(k) / (kKittiSamplePoints - 1);
+    for (std::size_t t = 0; t < recall.size() && t < precision.size(); ++t)
+      if (recall[t] >= r - 1e-12) out[static_cast<std::size_t>(k)] = std::max(out[static_cast<std::size_t>(k)], precision[t]);
+  }
+  return out;
+}
+
 namespace {
 
 bool sameType(const std::string& a, const char* b) { return strcasecmp(a.c_str(), b) == 0; }
@@ -290,7 +300,8 @@ Stat computeStatistics(const KittiFrame& f, const FrameOverlaps& ov, const std::
 
 // devkit eval_class for one class, difficulty and metric.
 void evalClass(const std::vector<KittiFrame>& frames, const std::vector<FrameOverlaps>& overlaps, ObjectClass cls,
-               int diff, double min_overlap, bool compute_aos, KittiCurve& precision, KittiCurve* aos) {
+               int diff, double min_overlap, bool compute_aos, bool exact_recall, KittiCurve& precision,
+               KittiCurve* aos) {
   const std::size_t nf = frames.size();
   std::vector<std::vector<int>> ignored_gt(nf), ignored_det(nf);
   std::vector<double> v;
@@ -301,8 +312,15 @@ void evalClass(const std::vector<KittiFrame>& frames, const std::vector<FrameOve
     computeStatistics(frames[i], overlaps[i], ignored_gt[i], ignored_det[i], false, min_overlap, false, 0, &v,
                       assigned, below);
   }
-  std::vector<double> thresholds = kittiThresholds(v, n_gt);
-  if (thresholds.size() > static_cast<std::size_t>(kKittiSamplePoints)) thresholds.resize(kKittiSamplePoints);
+  std::vector<double> thresholds;
+  if (exact_recall) {
+    thresholds = v;  // every true positive's score, highest first
+    std::sort(thresholds.begin(), thresholds.end(), std::greater<double>());
+    thresholds.erase(std::unique(thresholds.begin(), thresholds.end()), thresholds.end());
+  } else {
+    thresholds = kittiThresholds(v, n_gt);
+    if (thresholds.size() > static_cast<std::size_t>(kKittiSamplePoints)) thresholds.resize(kKittiSamplePoints);
+  }
   std::vector<Stat> pr(thresholds.size());
   for (std::size_t i = 0; i < nf; ++i) {
     for (std::size_t t = 0; t < thresholds.size(); ++t) {
@@ -321,6 +339,18 @@ void evalClass(const std::vector<KittiFrame>& frames, const std::vector<FrameOve
     *aos = KittiCurve();
     aos->num_gt = n_gt;
     aos->thresholds = thresholds;
+  }
+  if (exact_recall) {
+    std::vector<double> p, a;
+    for (std::size_t t = 0; t < thresholds.size(); ++t) {
+      const double tp = pr[t].tp, fp = pr[t].fp, fn = pr[t].fn;
+      precision.recall.push_back(tp + fn > 0 ? tp / (tp + fn) : 0.0);
+      p.push_back(tp + fp > 0 ? tp / (tp + fp) : 0.0);
+      a.push_back(tp + fp > 0 ? pr[t].similarity / (tp + fp) : 0.0);
+    }
+    precision.precision = kittiExactSamples(precision.recall, p);
+    if (aos) aos->recall = precision.recall, aos->precision = kittiExactSamples(precision.recall, a);
+    return;
   }
   for (std::size_t t = 0; t < thresholds.size(); ++t) {
     const double tp = pr[t].tp, fp = pr[t].fp, fn = pr[t].fn;
@@ -350,9 +380,36 @@ OverlapFn overlapFor(int metric) {
 
 }  // namespace
 
+namespace {
+
+KittiFalseBoxes countFalseBoxes(const std::vector<KittiFrame>& frames, const std::vector<ObjectClass>& classes) {
+  constexpr double kMatched = 0.1, kDontCare = 0.5;
+  KittiFalseBoxes out;
+  for (const KittiFrame& f : frames) {
+    for (const kitti::Label& d : f.det) {
+      const auto cls = classFromName(d.type);
+      if (!cls || std::find(classes.begin(), classes.end(), *cls) == classes.end()) continue;
+      bool matched = false;
+      for (const kitti::Label& g : f.gt) {
+        matched = sameType(g.type, "DontCare") ? kittiImageOverlap(d, g, 0) > kDontCare
+                                               : kittiBevOverlap(d, g, -1) >= kMatched;
+        if (matched) break;
+      }
+      if (matched) continue;
+      const std::size_t k = static_cast<std::size_t>(*cls) - 1;
+      ++out.per_class[k];
+      if (score(d) >= 0.5) ++out.per_class_score50[k];
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
 KittiResult evaluateKitti(const std::vector<KittiFrame>& frames, const KittiApOptions& options) {
   KittiResult result;
   result.num_frames = frames.size();
+  result.exact_recall = options.exact_recall;
   for (const auto& f : frames) {
     for (const auto& d : f.det) {
       if (d.alpha == -10) result.aos_valid = false;
@@ -370,6 +427,7 @@ KittiResult evaluateKitti(const std::vector<KittiFrame>& frames, const KittiApOp
       for (const auto& d : f.det) cr.num_det += sameType(d.type, className(cr.cls));
     }
   }
+  result.false_boxes = countFalseBoxes(frames, options.classes);
 
   // Work: overlaps in frame blocks for each metric, then one task per (class, difficulty) of that metric.
   const std::size_t kBlock = 256;
@@ -389,7 +447,7 @@ KittiResult evaluateKitti(const std::vector<KittiFrame>& frames, const KittiApOp
       auto& cr = result.classes[task / kKittiNumDifficulties];
       const int diff = static_cast<int>(task % kKittiNumDifficulties);
       const bool with_aos = m == static_cast<int>(KittiMetric::Box2D) && result.aos_valid;
-      evalClass(frames, overlaps, cr.cls, diff, cr.min_overlap, with_aos, cr.curves[m][diff],
+      evalClass(frames, overlaps, cr.cls, diff, cr.min_overlap, with_aos, options.exact_recall, cr.curves[m][diff],
                 with_aos ? &cr.aos[diff] : nullptr);
       progress.tick();
     });

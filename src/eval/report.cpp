@@ -126,6 +126,17 @@ std::map<std::string, double> metricsMap(const EvalReport& r) {
       }
     }
   }
+  if (r.kitti) {
+    const KittiFalseBoxes& fb = r.kitti->false_boxes;
+    const double nf = static_cast<double>(std::max<std::size_t>(1, r.kitti->num_frames));
+    m["kitti.false_boxes_per_frame"] = fb.total() / nf;
+    m["kitti.false_boxes_per_frame.score50"] = fb.totalScore50() / nf;
+    for (const auto& c : r.kitti->classes) {
+      const std::size_t k = static_cast<std::size_t>(c.cls) - 1;
+      m[std::string("kitti.false_boxes_per_frame.") + className(c.cls)] = fb.per_class[k] / nf;
+    }
+    m["kitti.exact_recall"] = r.kitti->exact_recall ? 1 : 0;
+  }
   if (r.kitti_loose) addKitti(m, "kitti_loose", *r.kitti_loose);
   if (r.waymo) {
     for (int l = 0; l < kWaymoNumLevels; ++l) {
@@ -188,7 +199,8 @@ std::string headlineTable(const EvalReport& r) {
   std::ostringstream o;
   char line[256];
   if (r.kitti) {
-    o << "KITTI AP (devkit, R40; R11 in brackets)  easy / moderate / hard\n";
+    o << "KITTI AP (" << (r.kitti->exact_recall ? "exact recall sampling" : "devkit")
+      << ", R40; R11 in brackets)  easy / moderate / hard\n";
     for (const auto& c : r.kitti->classes) {
       for (int mi : {2, 1, 0}) {
         const auto& cv = c.curves[mi];
@@ -198,6 +210,14 @@ std::string headlineTable(const EvalReport& r) {
         o << line;
       }
     }
+    const KittiFalseBoxes& fb = r.kitti->false_boxes;
+    const double nf = std::max<std::size_t>(1, r.kitti->num_frames);
+    std::snprintf(line, sizeof line,
+                  "  false boxes per frame (on no label, not in DontCare): %.2f (Car %.2f, Pedestrian %.2f, Cyclist "
+                  "%.2f); score >= 0.5: %.2f\n",
+                  fb.total() / nf, fb.per_class[0] / nf, fb.per_class[1] / nf, fb.per_class[2] / nf,
+                  fb.totalScore50() / nf);
+    o << line;
   }
   if (r.waymo) {
     o << "Waymo-style (3D IoU, 360 deg)            L1 AP / APH      L2 AP / APH\n";
@@ -363,11 +383,26 @@ std::vector<std::string> writeReport(const std::string& dir, const EvalReport& r
           "positives; detections below the minimum height are ignored. R11 = the devkit's printed 11-point AP "
           "(mean precision at its sample points 0, 4, ..., 40 of 41); R40 = mean precision at recall 1/40 .. 40/40. AOS uses the 2D "
           "matching. Values in percent.\n\n"
+       << (r.kitti->exact_recall
+               ? "**Exact recall sampling** (`--kitti-recall exact`): the precision at recall k/40 is the best precision "
+                 "at an actual recall of at least k/40, every true positive's score a threshold. The devkit's own "
+                 "sampling takes its k-th threshold as recall k/40, which holds only with 40 or more valid ground "
+                 "truths per class and difficulty: with fewer, matching every object still scores (TP - 1) / 40.\n\n"
+               : "")
        << "Ground truth counted (valid at each difficulty) and detections:\n\n"
        << "| class | easy | moderate | hard | detections |\n| --- | ---: | ---: | ---: | ---: |\n";
     for (const auto& c : r.kitti->classes) {
       md << "| " << className(c.cls) << " | " << c.curves[2][0].num_gt << " | " << c.curves[2][1].num_gt << " | "
          << c.curves[2][2].num_gt << " | " << c.num_det << " |\n";
+    }
+    {
+      const KittiFalseBoxes& fb = r.kitti->false_boxes;
+      const double nf = static_cast<double>(std::max<std::size_t>(1, r.kitti->num_frames));
+      md << "\nFalse boxes (detections with BEV IoU < 0.1 against every label of any type and not in a DontCare "
+            "region), per frame: **"
+         << fmt(fb.total() / nf) << "** (Car " << fmt(fb.per_class[0] / nf) << ", Pedestrian "
+         << fmt(fb.per_class[1] / nf) << ", Cyclist " << fmt(fb.per_class[2] / nf) << "); with score >= 0.5: "
+         << fmt(fb.totalScore50() / nf) << ".\n";
     }
     md << "\n### Strict IoU thresholds (Car 0.7, Pedestrian 0.5, Cyclist 0.5)\n\n";
     kittiTable(md, *r.kitti, pngs, "kitti_");

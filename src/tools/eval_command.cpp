@@ -38,6 +38,7 @@ struct EvalArgs {
   double bag_rate = 10.0, bag_start_time = 1.0e9, stamp_tolerance = 1e-3;
   std::string mot_similarity = "iou3d";
   double mot_threshold = 0.5, mot_zero_distance = 2.0, mot_max_range = 0;
+  std::string kitti_recall = "devkit";
   int threads = 2;
 };
 
@@ -195,6 +196,7 @@ int runEval(const EvalArgs& a) {
     for (const auto& f : data.frames) frames.push_back({f.gt_labels, f.pred_labels});
     KittiApOptions o;
     o.classes = classes;
+    o.exact_recall = a.kitti_recall == "exact";
     o.threads = a.threads;
     std::optional<ProgressBar> bar;
     o.progress = stageBar(bar, "KITTI AP");
@@ -303,6 +305,11 @@ CommandRegistrar registrar(
                      "tracking metrics: leave out boxes further than this from the sensor, m (0 = all)")
           ->capture_default_str()
           ->check(CLI::NonNegativeNumber);
+      app.add_option("--kitti-recall", a->kitti_recall,
+                     "KITTI AP recall sampling: devkit (the official devkit's, right with >= 40 valid objects per "
+                     "class and difficulty) or exact (precision at actual recall k/40; for small sets)")
+          ->capture_default_str()
+          ->check(CLI::IsMember({"devkit", "exact"}));
       app.add_option("--threads", a->threads, "worker threads")->capture_default_str()->check(CLI::PositiveNumber);
       return [a]() -> int { return runEval(*a); };
     });

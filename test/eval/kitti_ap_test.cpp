@@ -96,6 +96,61 @@ TEST(KittiAp, CraftedCaseR11AndR40) {
   EXPECT_NEAR(c.ap40(), 100.0 * (2.0 / 3.0) / 40.0, 1e-9);
 }
 
+// Exact recall sampling (KittiApOptions::exact_recall), on the crafted case above: recall 1/4 at precision 1, 2/4 at
+// 2/3. Precision at recall k/40: 1 for k <= 10, 2/3 for 10 < k <= 20, 0 beyond. R40 = (10 + 10 * 2/3) / 40 = 41.67;
+// R11 (k = 0, 4, ..., 40): k = 0, 4, 8 -> 1; 12, 16, 20 -> 2/3; the rest 0: (3 + 2) / 11 = 45.45.
+// And six perfectly detected cars: 100 with exact sampling, where the devkit's sampling caps them at 5/40 = 12.5.
+TEST(KittiAp, ExactRecallSamplingForSmallSets) {
+  std::vector<KittiFrame> frames(4);
+  for (int i = 0; i < 4; ++i) frames[i].gt = {car(100, 150, 200, 250, -3, 10)};
+  frames[0].det = {scored(car(100, 150, 200, 250, -3, 10), 0.9)};
+  frames[1].det = {scored(car(600, 150, 700, 250, 8, 10), 0.8)};
+  frames[2].det = {scored(car(100, 150, 200, 250, -3, 10), 0.7)};
+  KittiApOptions o;
+  o.exact_recall = true;
+  const KittiCurve& c = carResult(evaluateKitti(frames, o)).curves[static_cast<int>(KittiMetric::Box3D)][0];
+  EXPECT_NEAR(c.ap40(), 100.0 * (10 + 10 * 2.0 / 3.0) / 40.0, 1e-9);
+  EXPECT_NEAR(c.ap11(), 100.0 * (3 + 2) / 11.0, 1e-9);
+
+  std::vector<KittiFrame> six(6);
+  for (int i = 0; i < 6; ++i) {
+    six[i].gt = {car(100, 150, 200, 250, -3, 10 + i)};
+    six[i].det = {scored(six[i].gt[0], 0.5 + 0.05 * i)};
+  }
+  EXPECT_NEAR(carResult(evaluateKitti(six)).curves[2][1].ap40(), 100.0 * 5 / 40, 1e-9);
+  EXPECT_NEAR(carResult(evaluateKitti(six, o)).curves[2][1].ap40(), 100.0, 1e-9);
+  // On many objects the two samplings agree (the devkit's holds from 40 objects on).
+  std::vector<KittiFrame> many(80);
+  for (int i = 0; i < 80; ++i) {
+    many[i].gt = {car(100, 150, 200, 250, -3, 10)};
+    if (i % 4 != 3) many[i].det = {scored(many[i].gt[0], 0.9 - 0.001 * i)};
+    if (i % 5 == 0) many[i].det.push_back(scored(car(600, 150, 700, 250, 8, 10), 0.95 - 0.001 * i));
+  }
+  const double devkit = carResult(evaluateKitti(many)).curves[2][0].ap40();
+  const double exact = carResult(evaluateKitti(many, o)).curves[2][0].ap40();
+  EXPECT_NEAR(exact, devkit, 3.0);
+}
+
+// False boxes: a detection on no label of any type (here a Truck, a Misc and a DontCare region are labelled) counts;
+// one on the truck (wrong class) or inside the DontCare region does not.
+TEST(KittiAp, FalseBoxesAreThoseOnNoLabel) {
+  KittiFrame f;
+  kitti::Label truck = car(300, 150, 400, 250, 6, 30);
+  truck.type = "Truck";
+  kitti::Label dontcare = car(700, 150, 800, 250, 0, 0);
+  dontcare.type = "DontCare";
+  f.gt = {car(100, 150, 200, 250, -3, 10), truck, dontcare};
+  f.det = {scored(car(100, 150, 200, 250, -3, 10), 0.9),  // on the car
+           scored(car(300, 150, 400, 250, 6, 30), 0.8),   // on the truck
+           scored(car(700, 150, 800, 250, 15, 40), 0.7),  // in the DontCare region's image box
+           scored(car(500, 150, 560, 250, -10, 25), 0.6), // on nothing: false
+           scored(car(500, 150, 560, 250, 10, 50), 0.2)}; // on nothing, low score: false
+  const KittiResult r = evaluateKitti({f, KittiFrame{}});
+  EXPECT_EQ(r.false_boxes.per_class[0], 2);
+  EXPECT_EQ(r.false_boxes.per_class_score50[0], 1);
+  EXPECT_EQ(r.false_boxes.total(), 2);
+}
+
 // Devkit rules, on 80 copies of one frame (see above: 40 objects are not enough for 41 samples): a car (easy), a
 // Van, a DontCare region and a heavily occluded car (hard only). Detections: the car (score 0.9); at 0.95 the Van,
 // the occluded car, one inside the DontCare region's image box but far from everything in 3D, and a 20 px tall one

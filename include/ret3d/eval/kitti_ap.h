@@ -42,13 +42,21 @@ struct KittiApOptions {
   // 3D. Default: the benchmark's 0.7 / 0.5 / 0.5; kKittiLooseOverlap is the common loose setting.
   std::array<double, 3> min_overlap{{0.7, 0.5, 0.5}};
   int threads = 2;
+  // How precision is sampled at the 41 recall points. Devkit: its getThresholds, which adds one score threshold per
+  // true positive and takes the k-th threshold as recall k/40. That holds only with 40 or more valid ground truths per
+  // class and difficulty: with fewer, a detector matching every object still scores (TP - 1) / 40 at R40 (the
+  // ground truth itself scores 12.5 for the 6 moderate cars of six labelled frames). Exact: every true positive's
+  // score is a threshold, and the precision at recall k/40 is the best precision at an actual recall >= k/40 (the
+  // same matching, TP/FP/FN and DontCare rules); on large sets the two agree closely. For small validation sets.
+  bool exact_recall = false;
   // Called after each finished piece of work (from worker threads, serialised): done, total.
   std::function<void(std::size_t, std::size_t)> progress;
 };
 inline constexpr std::array<double, 3> kKittiStrictOverlap{{0.7, 0.5, 0.5}};
 inline constexpr std::array<double, 3> kKittiLooseOverlap{{0.5, 0.25, 0.25}};
 
-// Precision (or orientation similarity) at the 41 recall sample points, after the devkit's max-to-the-right filter.
+// Precision (or orientation similarity) at the 41 recall sample points, after the devkit's max-to-the-right filter
+// (with exact_recall: at recall k / 40 exactly).
 struct KittiCurve {
   std::vector<double> precision = std::vector<double>(kKittiSamplePoints, 0.0);
   std::vector<double> recall;      // actual recall at each evaluated score threshold (<= 41 entries)
@@ -69,10 +77,23 @@ struct KittiClassResult {
   std::array<KittiCurve, kKittiNumDifficulties> aos;
 };
 
+// Boxes a user would call false: detections of an evaluated class whose BEV IoU with every label of any type
+// (Van, Truck, Misc, Person_sitting and the other classes included; any difficulty) stays below 0.1 and that do not
+// lie in a DontCare region (over half of the detection's 2D box, the devkit's DontCare rule). Boxes on walls, poles
+// and vegetation, not boxes of the wrong size or class on a real object. Counted at every score, and from score 0.5.
+struct KittiFalseBoxes {
+  std::array<int, 3> per_class{{0, 0, 0}};        // indexed by ObjectClass value - 1
+  std::array<int, 3> per_class_score50{{0, 0, 0}};
+  int total() const { return per_class[0] + per_class[1] + per_class[2]; }
+  int totalScore50() const { return per_class_score50[0] + per_class_score50[1] + per_class_score50[2]; }
+};
+
 struct KittiResult {
   std::vector<KittiClassResult> classes;
   bool aos_valid = true;  // false when some detection has alpha == -10 (the devkit then skips AOS)
+  bool exact_recall = false;  // KittiApOptions::exact_recall of the run
   std::size_t num_frames = 0;
+  KittiFalseBoxes false_boxes;
 };
 
 KittiResult evaluateKitti(const std::vector<KittiFrame>& frames, const KittiApOptions& options = {});
@@ -86,6 +107,9 @@ double kittiBevOverlap(const kitti::Label& det, const kitti::Label& gt, int crit
 double kitti3dOverlap(const kitti::Label& det, const kitti::Label& gt, int criterion = -1);
 // Scores of true positives -> the score thresholds that sample recall at 41 points (devkit getThresholds).
 std::vector<double> kittiThresholds(std::vector<double> tp_scores, int num_gt);
+// Precision interpolated at recall k / 40, k = 0..40: the best precision at an actual recall of at least k / 40
+// (0 where the recall is never reached). `recall` and `precision` are per score threshold.
+std::vector<double> kittiExactSamples(const std::vector<double>& recall, const std::vector<double>& precision);
 double kittiAp11(const std::vector<double>& precision);  // percent
 double kittiAp40(const std::vector<double>& precision);  // percent
 

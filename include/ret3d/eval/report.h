@@ -3,6 +3,7 @@
 //
 // metrics.json keys (read by other tools; exactly these names):
 //   kitti.<Class>.<3d|bev|2d|aos>.<R11|R40>.<easy|moderate|hard>     strict IoU 0.7 / 0.5 / 0.5
+//   kitti.false_boxes_per_frame[.<Class>|.score50], kitti.exact_recall (1 with --kitti-recall exact)
 //   waymo.<Class|mean>.<L1|L2>.<AP|APH>
 //   mot.<Class>.<MOTA|MOTP|IDSW|FRAG|MT|ML|HOTA|DetA|AssA>            IDSW, FRAG: counts; MT, ML: % of GT tracks
 //   mot.<Class|all>.<IdStability|IdCoverage>                          eval/id_stability.h (centre distance < 2 m)
