@@ -92,7 +92,7 @@ DetectorTrainResult trainDetector(const DetectorTrainJob& job) {
     RET3D_INFO("  " << src.root << " (" << data.layout(k) << " layout, labels cover "
                     << labelCoverName(src.cover) << "): " << data.setSize(k) << " frames x weight " << src.weight
                     << " = ~" << std::fixed << std::setprecision(1) << n << " per epoch, " << 100.0 * n / drawn
-                    << " % of the batches" << std::defaultfloat);
+                    << " % of an epoch" << std::defaultfloat);
   }
 
   std::shared_ptr<nn::DetectorModel> model;
