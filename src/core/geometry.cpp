@@ -127,6 +127,21 @@ bool pointInBox(const Box& b, const Eigen::Vector3d& p) {
   return std::abs(lx) <= 0.5 * b.length && std::abs(ly) <= 0.5 * b.width;
 }
 
+bool BevWedge::contains(const Eigen::Vector2d& p) const {
+  auto cross = [](const Eigen::Vector2d& u, const Eigen::Vector2d& v) { return u.x() * v.y() - u.y() * v.x(); };
+  const Eigen::Vector2d d = p - apex;
+  // The sign of ray_a x ray_b fixes the orientation, so a mirrored wedge (flip augmentation) tests alike.
+  const double s = cross(ray_a, ray_b) >= 0 ? 1.0 : -1.0;
+  if (s * cross(ray_a, d) >= 0 && s * cross(d, ray_b) >= 0) return true;
+  if (margin <= 0) return false;
+  // Outside a convex wedge, the distance to it is the distance to the nearer edge ray.
+  auto toRay = [&](const Eigen::Vector2d& r) {
+    const Eigen::Vector2d u = r.normalized();
+    return d.dot(u) > 0 ? std::abs(cross(u, d)) : d.norm();
+  };
+  return std::min(toRay(ray_a), toRay(ray_b)) <= margin;
+}
+
 std::uint32_t countPointsInBox(const Box& b, const PointCloud& cloud) {
   std::uint32_t n = 0;
   for (const Point& p : cloud.points) {

@@ -25,13 +25,16 @@ double gaussianRadius(double h, double w, double o) {
 
 torch::Tensor supervisionMask(const GroundTruth& gt, const BevGeometry& g, int stride, int h, int w) {
   auto mask = torch::ones({h, w});
-  if (gt.ignore.empty() && gt.supervised_fov_deg <= 0) return mask;
+  if (gt.ignore.empty() && gt.ignore_regions.empty() && gt.supervised_fov_deg <= 0 && !gt.labelled_view) return mask;
   auto m = mask.accessor<float, 2>();
   const double half_fov = 0.5 * gt.supervised_fov_deg * M_PI / 180.0;
   for (int v = 0; v < h; ++v)
     for (int u = 0; u < w; ++u) {
       const Eigen::Vector2d p = g.featureToMetric(u + 0.5, v + 0.5, stride);
       if (half_fov > 0 && std::abs(std::atan2(p.y(), p.x())) > half_fov) m[v][u] = 0;
+      if (gt.labelled_view && !gt.labelled_view->contains(p)) m[v][u] = 0;
+      for (const BevWedge& r : gt.ignore_regions)
+        if (m[v][u] != 0 && r.contains(p)) m[v][u] = 0;
       for (const Box& b : gt.ignore)
         if (pointInBox(b, Eigen::Vector3d(p.x(), p.y(), b.z))) m[v][u] = 0;
     }

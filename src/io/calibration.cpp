@@ -87,6 +87,36 @@ std::optional<Eigen::Vector2d> Calibration::projectRect(const Eigen::Vector3d& p
   return Eigen::Vector2d(uvw.x() / uvw.z(), uvw.y() / uvw.z());
 }
 
+BevWedge imageRegionWedge(const Calibration& calib, double u_min, double u_max, double v_min, double v_max,
+                          double margin) {
+  const Eigen::Matrix3d A = calib.P2.leftCols<3>();
+  if (std::abs(A.determinant()) < 1e-12) throw std::invalid_argument("imageRegionWedge: P2 is singular");
+  const Eigen::Vector3d centre = -A.inverse() * calib.P2.col(3);  // camera 2's centre, rectified frame
+  const Eigen::Vector2d apex = calib.rectToVelo(centre).head<2>();
+  auto bevRay = [&](double u, double v) {
+    const Eigen::Vector3d d = A.inverse() * Eigen::Vector3d(u, v, 1.0);
+    return Eigen::Vector2d((calib.rectToVelo(centre + d).head<2>() - apex).normalized());
+  };
+  const Eigen::Vector2d mid = bevRay(0.5 * (u_min + u_max), 0.5 * (v_min + v_max));
+  auto angle = [&](const Eigen::Vector2d& r) { return std::atan2(mid.x() * r.y() - mid.y() * r.x(), mid.dot(r)); };
+  // Per side, the ray farthest from the middle one (the side's sign decided by the middle row's ray).
+  auto widest = [&](double u) {
+    const double side = angle(bevRay(u, 0.5 * (v_min + v_max))) >= 0 ? 1.0 : -1.0;
+    Eigen::Vector2d best = bevRay(u, v_min);
+    for (double v : {0.5 * (v_min + v_max), v_max}) {
+      const Eigen::Vector2d r = bevRay(u, v);
+      if (side * angle(r) > side * angle(best)) best = r;
+    }
+    return best;
+  };
+  BevWedge w;
+  w.apex = apex;
+  w.ray_a = widest(u_min);
+  w.ray_b = widest(u_max);
+  w.margin = margin;
+  return w;
+}
+
 Calibration readCalibration(const std::string& path) {
   std::map<Key, std::vector<double>> values;
   std::map<Key, int> seen_at;

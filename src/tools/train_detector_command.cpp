@@ -1,4 +1,5 @@
-// `ret3d train detector --data DIR --config YAML --out MODEL [--resume]`: trains the LWD-3D base detector.
+// `ret3d train detector --data DIR... [--data-weights W...] [--labels-cover auto|all|camera...] --config YAML
+//  --out MODEL [--resume]`: trains the LWD-3D base detector.
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -13,9 +14,22 @@ namespace {
 CommandRun setup(CLI::App& app) {
   auto job = std::make_shared<DetectorTrainJob>();
   auto config = std::make_shared<std::string>();
-  app.add_option("--data", job->data_dirs, "KITTI tracking-layout folder(s) (ROOT or ROOT/training), used together")
+  app.add_option("--data", job->data_dirs,
+                 "KITTI folder(s) (ROOT or ROOT/training), used together; each in the tracking layout (label_02, "
+                 "velodyne/SSSS/) or the object layout (label_2, velodyne/FFFFFF.bin), detected per folder")
       ->required()
       ->check(CLI::ExistingDirectory);
+  app.add_option("--data-weights", job->data_weights,
+                 "one weight per --data folder (or one for all; default 1): each frame of a folder is drawn WEIGHT "
+                 "times per epoch on average (fractions: a seeded draw per epoch), e.g. --data sim real "
+                 "--data-weights 1 4")
+      ->check(CLI::NonNegativeNumber);
+  auto covers = std::make_shared<std::vector<std::string>>();
+  app.add_option("--labels-cover", *covers,
+                 "where each --data folder's labels exist (one per folder, or one for all; default auto): all = all "
+                 "around (simulator), camera = camera 2's view only (real KITTI; outside it no loss), auto = camera "
+                 "when every object label has a 2D box in image 2, else all")
+      ->check(CLI::IsMember({"auto", "all", "camera"}));
   app.add_option("--config", *config, "detector config YAML (config/detector/*.yaml)")
       ->required()
       ->check(CLI::ExistingFile);
@@ -28,7 +42,8 @@ CommandRun setup(CLI::App& app) {
   auto threads = std::make_shared<int>(0);
   app.add_option("--threads", *threads, "torch threads (default: the config's train.threads, else inference.threads)")
       ->check(CLI::PositiveNumber);
-  return [job, config, threads]() -> int {
+  return [job, config, threads, covers]() -> int {
+    for (const std::string& c : *covers) job->label_cover.push_back(labelCoverFromName(c));
     std::ifstream in(*config);
     std::stringstream ss;
     ss << in.rdbuf();

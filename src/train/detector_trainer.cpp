@@ -49,6 +49,27 @@ double learningRate(const TrainOptions& t, int step, int total) {
   return t.learning_rate * (0.05 + 0.95 * 0.5 * (1 + std::cos(M_PI * std::min(1.0, p))));
 }
 
+// The job's folders with their weights and label covers (each list empty, one value for all, or one per folder).
+std::vector<DetectorDataSource> dataSources(const DetectorTrainJob& job) {
+  const std::size_t n = job.data_dirs.size();
+  auto check = [n](std::size_t given, const char* what) {
+    if (given > 1 && given != n)
+      throw std::invalid_argument(std::string("train detector: ") + std::to_string(given) + " " + what + " for " +
+                                  std::to_string(n) + " data folders (give one for all, or one per folder)");
+  };
+  check(job.data_weights.size(), "weights");
+  check(job.label_cover.size(), "label covers");
+  std::vector<DetectorDataSource> out;
+  for (std::size_t i = 0; i < n; ++i) {
+    DetectorDataSource s;
+    s.root = job.data_dirs[i];
+    if (!job.data_weights.empty()) s.weight = job.data_weights[job.data_weights.size() == 1 ? 0 : i];
+    if (!job.label_cover.empty()) s.cover = job.label_cover[job.label_cover.size() == 1 ? 0 : i];
+    out.push_back(s);
+  }
+  return out;
+}
+
 }  // namespace
 
 DetectorTrainResult trainDetector(const DetectorTrainJob& job) {
@@ -59,11 +80,20 @@ DetectorTrainResult trainDetector(const DetectorTrainJob& job) {
   torch::set_num_threads(t.threads > 0 ? t.threads : o.inference.threads);
   torch::manual_seed(t.seed);
 
-  DetectorDataset data(job.data_dirs, o.model, t.max_frames);
-  std::string dirs;
-  for (const std::string& d : job.data_dirs) dirs += (dirs.empty() ? "" : ", ") + d;
-  RET3D_INFO("train detector: " << data.size() << " frames from " << dirs << ", head "
+  DetectorDataset data(dataSources(job), o.model, t.max_frames);
+  double drawn = 0;
+  for (std::size_t k = 0; k < data.sources().size(); ++k) drawn += data.setSize(k) * data.sources()[k].weight;
+  if (drawn <= 0) throw std::invalid_argument("train detector: every data weight is 0");
+  RET3D_INFO("train detector: " << data.size() << " frames, ~" << std::lround(drawn) << " drawn per epoch, head "
                                 << headTypeName(o.model.head) << ", grid " << o.model.geometry.describe());
+  for (std::size_t k = 0; k < data.sources().size(); ++k) {
+    const DetectorDataSource& src = data.sources()[k];
+    const double n = data.setSize(k) * src.weight;
+    RET3D_INFO("  " << src.root << " (" << data.layout(k) << " layout, labels cover "
+                    << labelCoverName(src.cover) << "): " << data.setSize(k) << " frames x weight " << src.weight
+                    << " = ~" << std::fixed << std::setprecision(1) << n << " per epoch, " << 100.0 * n / drawn
+                    << " % of an epoch" << std::defaultfloat);
+  }
 
   std::shared_ptr<nn::DetectorModel> model;
   Checkpoint ck;
@@ -101,8 +131,13 @@ DetectorTrainResult trainDetector(const DetectorTrainJob& job) {
                             torch::optim::AdamWOptions(t.learning_rate).weight_decay(t.weight_decay));
   if (job.resume && ck.step > 0) torch::load(optim, base + ".ckpt.optim");
 
-  const int batches_per_epoch = static_cast<int>((data.size() + t.batch_size - 1) / t.batch_size);
-  const int total_steps = batches_per_epoch * t.epochs;
+  // Fractional weights make the epochs' lengths differ; each epoch's order is fixed by (seed, epoch) alone.
+  std::vector<int> epoch_batches_n(t.epochs);
+  int total_steps = 0;
+  for (int e = 0; e < t.epochs; ++e) {
+    epoch_batches_n[e] = static_cast<int>((epochOrder(data, t.seed, e).size() + t.batch_size - 1) / t.batch_size);
+    total_steps += epoch_batches_n[e];
+  }
   ProgressBar bar("train detector", static_cast<std::size_t>(total_steps));
   if (ck.step > 0) bar.tick(static_cast<std::size_t>(ck.step));
   auto last_ckpt = std::chrono::steady_clock::now();
@@ -112,10 +147,8 @@ DetectorTrainResult trainDetector(const DetectorTrainJob& job) {
   for (int epoch = ck.epoch; epoch < t.epochs; ++epoch) {
     // The order of an epoch and each sample's augmentation depend only on (seed, epoch, position): a resumed run
     // sees exactly the batches the interrupted one would have.
-    std::vector<std::size_t> order(data.size());
-    std::iota(order.begin(), order.end(), 0);
-    std::mt19937 order_rng(t.seed * 7919u + static_cast<unsigned>(epoch));
-    std::shuffle(order.begin(), order.end(), order_rng);
+    const std::vector<std::size_t> order = epochOrder(data, t.seed, epoch);
+    const int batches_per_epoch = epoch_batches_n[epoch];
     double epoch_loss = 0;
     int epoch_batches = 0;
     for (int b = (epoch == ck.epoch ? ck.batch : 0); b < batches_per_epoch; ++b) {
@@ -135,6 +168,8 @@ DetectorTrainResult trainDetector(const DetectorTrainJob& job) {
         gt.boxes = std::move(s.boxes);
         gt.velocity_valid = std::move(s.velocity_valid);
         gt.ignore = std::move(s.ignore);
+        gt.ignore_regions = std::move(s.ignore_regions);
+        gt.labelled_view = s.labelled_view;
         gt.supervised_fov_deg = t.supervised_fov_deg;
         gts.push_back(std::move(gt));
       }

@@ -41,4 +41,14 @@ std::uint32_t countPointsInBox(const Box& b, const PointCloud& cloud);
 // Points inside each box, in one pass over the cloud (a coarse grid over the boxes keeps it fast).
 std::vector<std::uint32_t> countPointsInBoxes(const std::vector<Box>& boxes, const PointCloud& cloud);
 
+// A BEV wedge: the region between two rays from one apex (less than 180 degrees apart), grown by a margin; e.g. the
+// part of the ground a camera sees, or what lies behind an image region.
+struct BevWedge {
+  Eigen::Vector2d apex = Eigen::Vector2d::Zero();
+  Eigen::Vector2d ray_a = Eigen::Vector2d::UnitX(), ray_b = Eigen::Vector2d::UnitY();  // directions of the edges
+  double margin = 0;  // points at most this far outside still count as inside (m)
+  // Inside the wedge, or within margin of it.
+  bool contains(const Eigen::Vector2d& p) const;
+};
+
 }  // namespace ret3d

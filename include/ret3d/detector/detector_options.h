@@ -117,7 +117,8 @@ struct TrainOptions {
   // cheaper grid still trains on far objects) instead of at its centre.
   bool multiscale_random_position = false;
   int threads = 0;                // torch threads while training (0 = inference.threads)
-  // Real KITTI labels cover only the front camera's view: supervise objectness only within +-fov/2 of x (0 = all).
+  // Objectness supervised only within +-fov/2 of x (0 = all). A crude stand-in for the labelled view: a camera-view
+  // set (`ret3d train detector --labels-cover camera`, or auto) is masked by its calibrated camera frustum instead.
   double supervised_fov_deg = 0.0;
   double loss_weight_regression = 2.0;
   double loss_weight_velocity = 0.5;

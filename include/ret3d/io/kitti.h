@@ -14,6 +14,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "ret3d/core/geometry.h"
 #include "ret3d/core/types.h"
 
 namespace ret3d {
@@ -89,6 +90,16 @@ void writeCalibration(const std::string& path, const Calibration& calib);
 // A KITTI-like calibration, used by the simulator: the real values of the tracking benchmark's sequences 0000-0013
 // (one calibration, recorded 2011-09-26; identical to ../shared/data's calib/0001.txt).
 Calibration defaultCalibration();
+
+// KITTI's usual image size (pixels); images of some drives are a few pixels smaller.
+inline const Eigen::Vector2d kImageSize(1242, 375);
+
+// What lies behind the image-2 columns [u_min, u_max] (rows [v_min, v_max]) in the LiDAR frame's BEV: a wedge from
+// camera 2's centre between the rays through the two side columns. The camera is slightly tilted, so each side's ray
+// is taken at the top, middle and bottom rows and the widest kept. The whole image gives the labelled field of view;
+// a DontCare box gives the region where unlabelled objects may stand.
+BevWedge imageRegionWedge(const Calibration& calib, double u_min, double u_max, double v_min, double v_max,
+                          double margin = 0);
 
 // ---- label <-> box ----
 // Track ids: KITTI tracking ids start at 0 (-1 = none, e.g. DontCare) while Box::track_id 0 means none, so

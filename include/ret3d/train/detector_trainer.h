@@ -8,11 +8,14 @@
 #include <vector>
 
 #include "ret3d/detector/detector_options.h"
+#include "ret3d/train/detector_dataset.h"
 
 namespace ret3d {
 
 struct DetectorTrainJob {
-  std::vector<std::string> data_dirs;  // KITTI tracking layout folders, used together
+  std::vector<std::string> data_dirs;  // KITTI folders (tracking or object layout), used together
+  std::vector<double> data_weights;    // per folder (or one for all; empty = 1): frames drawn per epoch per frame
+  std::vector<LabelCover> label_cover;  // per folder (or one for all; empty = Auto): where the labels exist
   std::string out_model;      // final model file; checkpoints beside it (<out>.ckpt, <out>.ckpt.optim)
   DetectorOptions options;
   std::string config_text;    // the YAML the options came from, stored in the model file
