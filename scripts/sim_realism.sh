@@ -70,35 +70,35 @@ set multiplot layout 3,3 title "ret3d sim (urban_street, HDL-64E, 60 frames) vs 
 set grid
 set key top right
 set style data lines
-set title "range ($(w1 range) m)"
+set title "range\n$(w1 range) m"
 set xlabel "range (m), 1 m bins"
 set ylabel "fraction of points"
 set logscale y
 set xrange [0:100]
 plot $(curves range)
 unset logscale y
-set title "intensity ($(w1 intensity)); zero-intensity fraction ($(w1 zero))"
+set title "intensity: $(w1 intensity)\nfraction of zero-intensity returns: $(w1 zero)"
 set xlabel "intensity (reflectance), 0.02 bins"
 set xrange [0:1]
 plot $(curves intensity)
-set title "points per ring, real: estimated from elevation ($(w1 rings) rings)"
+set title "points per ring, real: estimated from elevation\n$(w1 rings) rings"
 set xlabel "ring (0 = lowest beam)"
 set ylabel "points per frame"
 set xrange [-1:64]
 plot "$OUT/sim_rings.dat" u 1:2 w linespoints pt 7 ps 0.6 lw 2 lc rgb "#d62728" t "simulated" $(before rings 1:2), \
      "$OUT/real_rings.dat" u 1:2 w linespoints pt 7 ps 0.6 lw 2 lc rgb "#1f77b4" t "real (unlabelled)", \
      "$OUT/real_object_rings.dat" u 1:2 w lines lw 1 dt 2 lc rgb "#2ca02c" t "real (kitti_object)"
-set title "height above a flat ground (z + 1.73 m) ($(w1 height) m)"
+set title "height above a flat ground (z + 1.73 m)\n$(w1 height) m"
 set xlabel "height (m), 0.1 m bins"
 set ylabel "fraction of points"
 set logscale y
 set xrange [-1:5]
 plot $(curves height)
-set title "height std-dev per 0.5 m BEV cell with >= 5 points, < 40 m ($(w1 scatter) m)"
+set title "height std-dev per 0.5 m BEV cell with >= 5 points, < 40 m\n$(w1 scatter) m"
 set xlabel "std-dev of z in the cell (m), 0.05 m bins (last bin: the rest)"
 set xrange [0:2]
 plot $(curves scatter)
-set title "points > 0.3 m above ground per occupied 0.5 m BEV cell, 10-40 m ($(w1 cellpoints) points)"
+set title "points > 0.3 m up per occupied 0.5 m BEV cell, 10-40 m\n$(w1 cellpoints) points"
 set xlabel "points in the cell (last bin: 50 or more)"
 set xrange [0:51]
 plot $(curves cellpoints)

@@ -293,11 +293,12 @@ Sweep RayCaster::cast(const Eigen::Isometry3d& T, std::uint64_t seed, int frame,
                            sensor_.intensity_noise_sigma * rng.normal();
             inten = std::clamp(inten, 0.0, 1.0);
             if (inten < sensor_.zero_intensity_below) inten = 0.0;
-            if (sensor_.zero_intensity_far > 0) {
+            if (sensor_.zero_intensity_near > 0 || sensor_.zero_intensity_far > 0) {
               const double ramp = std::clamp((r - sensor_.zero_intensity_near_range) /
                                                  (sensor_.zero_intensity_far_range - sensor_.zero_intensity_near_range),
                                              0.0, 1.0);
-              if (rng.uniform() < sensor_.zero_intensity_far * ramp) inten = 0.0;
+              const double p0 = sensor_.zero_intensity_near + (sensor_.zero_intensity_far - sensor_.zero_intensity_near) * ramp;
+              if (rng.uniform() < p0) inten = 0.0;
             }
             Point& p = sw.points[slot];
             p.x = static_cast<float>(d.x() * r);

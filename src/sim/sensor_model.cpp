@@ -72,7 +72,7 @@ SensorModel loadSensorModel(const std::string& path) {
       {"far_dropout", &s.far_dropout},                       {"incidence_exponent", &s.incidence_exponent},
       {"range_attenuation", &s.range_attenuation},           {"intensity_gain", &s.intensity_gain},
       {"intensity_noise_sigma", &s.intensity_noise_sigma},   {"zero_intensity_below", &s.zero_intensity_below},
-      {"zero_intensity_far", &s.zero_intensity_far},         {"zero_intensity_near_range", &s.zero_intensity_near_range},
+      {"zero_intensity_near", &s.zero_intensity_near},       {"zero_intensity_far", &s.zero_intensity_far},         {"zero_intensity_near_range", &s.zero_intensity_near_range},
       {"zero_intensity_far_range", &s.zero_intensity_far_range}};
   for (const auto& kv : root) {
     const std::string key = kv.first.as<std::string>();
@@ -119,6 +119,7 @@ SensorModel loadSensorModel(const std::string& path) {
   if (s.range_noise_sigma < 0 || s.intensity_noise_sigma < 0) fail(path, "range_noise_sigma", "must be >= 0");
   if (s.zero_intensity_below < 0 || s.zero_intensity_below > 1) fail(path, "zero_intensity_below", "must be in [0, 1]");
   if (s.zero_intensity_far < 0 || s.zero_intensity_far > 1) fail(path, "zero_intensity_far", "must be in [0, 1]");
+  if (s.zero_intensity_near < 0 || s.zero_intensity_near > 1) fail(path, "zero_intensity_near", "must be in [0, 1]");
   if (s.zero_intensity_far_range <= s.zero_intensity_near_range)
     fail(path, "zero_intensity_far_range", "must be above zero_intensity_near_range");
   // Ring 0 is the lowest beam.

@@ -138,6 +138,7 @@ TEST(Realism, ZeroIntensityReturnsAreKeptWithIntensityZero) {
   SensorModel sensor = sensorByName("hdl64e", RET3D_SOURCE_DIR);
   sensor.ego_body_box.clear();
   sensor.zero_intensity_below = 0;
+  sensor.zero_intensity_near = 0;
   sensor.zero_intensity_far = 0;
   const TriangleMesh dark = groundScene(0.08f);
   const Sweep plain = castOnce(sensor, dark);
@@ -165,6 +166,9 @@ TEST(Realism, ZeroIntensityReturnsAreKeptWithIntensityZero) {
     if (ramp.returned[slot] && std::hypot(p.x, p.y) < 9 && p.intensity == 0.0f) ++near_zero;
   }
   EXPECT_EQ(near_zero, 0u);
+  // A flat probability at every range.
+  sensor.zero_intensity_near = sensor.zero_intensity_far = 0.3;
+  EXPECT_NEAR(zeroFraction(castOnce(sensor, groundScene(0.5f))), 0.3, 0.02);
 }
 
 TEST(Realism, PorousVegetationSpreadsReturnsInDepth) {

@@ -30,9 +30,10 @@ struct SensorModel {
   bool motion_distortion = false;      // rays of one sweep leave from the pose at their own firing time
   // Zero-intensity returns (real HDL-64E scans report reflectance 0 for 10-16 % of their returns: dark and far
   // surfaces below the detector's threshold): a return whose intensity falls below `zero_intensity_below` keeps its
-  // point with intensity 0, and so does one with probability `zero_intensity_far` x the ramp from 0 at
-  // `zero_intensity_near_range` to 1 at `zero_intensity_far_range` (m). 0 = off.
+  // point with intensity 0, and so does one drawn with a probability going linearly from `zero_intensity_near` up to
+  // `zero_intensity_near_range` (m) to `zero_intensity_far` from `zero_intensity_far_range` on. 0 = off.
   double zero_intensity_below = 0.0;
+  double zero_intensity_near = 0.0;
   double zero_intensity_far = 0.0;
   double zero_intensity_near_range = 20.0;
   double zero_intensity_far_range = 50.0;
