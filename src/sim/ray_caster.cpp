@@ -281,7 +281,8 @@ Sweep RayCaster::cast(const Eigen::Isometry3d& T, std::uint64_t seed, int frame,
             if (surf.porosity > 0 && rng.uniform() < surf.porosity) {
               // Into the crown: the return comes from a leaf at a random depth before the next surface.
               const Eigen::Vector3d o(rh.ray.org_x[k], rh.ray.org_y[k], rh.ray.org_z[k]);
-              const Eigen::Vector3d wdir = Eigen::Vector3d(rh.ray.dir_x[k], rh.ray.dir_y[k], rh.ray.dir_z[k]).normalized();
+              const Eigen::Vector3d wdir =
+                  Eigen::Vector3d(rh.ray.dir_x[k], rh.ray.dir_y[k], rh.ray.dir_z[k]).normalized();
               double depth = kPorousDepth;
               intersect(o + wdir * (range + 1e-3), wdir, 0.0, kPorousDepth, &depth, nullptr);
               range += rng.uniform() * depth;
@@ -297,7 +298,8 @@ Sweep RayCaster::cast(const Eigen::Isometry3d& T, std::uint64_t seed, int frame,
               const double ramp = std::clamp((r - sensor_.zero_intensity_near_range) /
                                                  (sensor_.zero_intensity_far_range - sensor_.zero_intensity_near_range),
                                              0.0, 1.0);
-              const double p0 = sensor_.zero_intensity_near + (sensor_.zero_intensity_far - sensor_.zero_intensity_near) * ramp;
+              const double p0 =
+                  sensor_.zero_intensity_near + (sensor_.zero_intensity_far - sensor_.zero_intensity_near) * ramp;
               if (rng.uniform() < p0) inten = 0.0;
             }
             Point& p = sw.points[slot];

@@ -242,7 +242,8 @@ std::vector<StatDistance> compareStats(const std::string& prefix_a, const std::s
     std::vector<double> ca, a, cb, b;
     readDat(prefix_a + "_" + name + ".dat", &ca, &a);
     readDat(prefix_b + "_" + name + ".dat", &cb, &b);
-    if (ca != cb) throw std::runtime_error(prefix_a + "_" + name + ".dat and " + prefix_b + "_" + name + ".dat: different bins");
+    if (ca != cb)
+      throw std::runtime_error(prefix_a + "_" + name + ".dat and " + prefix_b + "_" + name + ".dat: different bins");
     double sa = 0, sb = 0;
     for (double v : a) sa += v;
     for (double v : b) sb += v;

@@ -618,12 +618,14 @@ void buildStaticGeometry(Scene& scene, const SimConfig& config, Rng& rng, double
           if (!nearRoute(p, 5) || !footprintFree(scene, fb, 0.1, keep_out)) continue;
           const double z0 = scene.groundHeight(p.x(), p.y());
           mesh.addEllipsoid(poseAt(p, z0 + 0.6 * r, extra.uniform(0, M_PI)),
-                            V3f(static_cast<float>(r), static_cast<float>(r * extra.uniform(0.6, 1.0)), static_cast<float>(0.8 * r)),
+                            V3f(static_cast<float>(r), static_cast<float>(r * extra.uniform(0.6, 1.0)),
+                                static_cast<float>(0.8 * r)),
                             8, 5, drawSurface(config, "foliage", extra));
         }
       }
       if (cc.bollard_spacing.hi > 0 && SW > 0) {
-        for (double s = extra.uniform(0, cc.bollard_spacing.hi); s < L; s += std::max(0.5, draw(extra, cc.bollard_spacing))) {
+        for (double s = extra.uniform(0, cc.bollard_spacing.hi); s < L;
+             s += std::max(0.5, draw(extra, cc.bollard_spacing))) {
           const PathPose pp = road.center.at(s);
           const V2 p = pp.p + side * (W + 0.3) * normalLeft(pp.yaw);
           Box fb;

@@ -72,7 +72,8 @@ SensorModel loadSensorModel(const std::string& path) {
       {"far_dropout", &s.far_dropout},                       {"incidence_exponent", &s.incidence_exponent},
       {"range_attenuation", &s.range_attenuation},           {"intensity_gain", &s.intensity_gain},
       {"intensity_noise_sigma", &s.intensity_noise_sigma},   {"zero_intensity_below", &s.zero_intensity_below},
-      {"zero_intensity_near", &s.zero_intensity_near},       {"zero_intensity_far", &s.zero_intensity_far},         {"zero_intensity_near_range", &s.zero_intensity_near_range},
+      {"zero_intensity_near", &s.zero_intensity_near},       {"zero_intensity_far", &s.zero_intensity_far},
+      {"zero_intensity_near_range", &s.zero_intensity_near_range},
       {"zero_intensity_far_range", &s.zero_intensity_far_range}};
   for (const auto& kv : root) {
     const std::string key = kv.first.as<std::string>();
@@ -90,8 +91,10 @@ SensorModel loadSensorModel(const std::string& path) {
       for (std::size_t i = 0; i < v.size(); ++i)
         s.elevation_deg.push_back(number(path, v[i], key + "[" + std::to_string(i) + "]", -90, 90));
     } else if (key == "ego_body_box") {
-      if (!v.IsSequence() || (v.size() != 6 && v.size() != 0)) fail(path, key, "expected [x_min, x_max, y_min, y_max, z_min, z_max] or []");
-      for (std::size_t i = 0; i < v.size(); ++i) s.ego_body_box.push_back(number(path, v[i], key + "[" + std::to_string(i) + "]", -100, 100));
+      if (!v.IsSequence() || (v.size() != 6 && v.size() != 0))
+        fail(path, key, "expected [x_min, x_max, y_min, y_max, z_min, z_max] or []");
+      for (std::size_t i = 0; i < v.size(); ++i)
+        s.ego_body_box.push_back(number(path, v[i], key + "[" + std::to_string(i) + "]", -100, 100));
       for (int a = 0; a < static_cast<int>(s.ego_body_box.size()) / 2; ++a)
         if (s.ego_body_box[2 * a] >= s.ego_body_box[2 * a + 1]) fail(path, key, "each min must be below its max");
     } else if (key == "elevation_blocks") {

@@ -37,9 +37,11 @@ SequenceReport simulateSequence(const SimOptions& opt, int index,
     Rng mount(mix64(seq_seed ^ 0x6d6f756e74ULL));
     const double deg = M_PI / 180.0;
     T_base_lidar.translation().z() += mount.normal(0, cfg.mount_height_jitter);
-    const double pitch = mount.normal(0, cfg.mount_tilt_jitter_deg) * deg, roll = mount.normal(0, cfg.mount_tilt_jitter_deg) * deg;
-    T_base_lidar.linear() = (Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) * Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
-                                .toRotationMatrix();
+    const double pitch = mount.normal(0, cfg.mount_tilt_jitter_deg) * deg;
+    const double roll = mount.normal(0, cfg.mount_tilt_jitter_deg) * deg;
+    T_base_lidar.linear() =
+        (Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) * Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+            .toRotationMatrix();
   }
 
   Scene scene;

@@ -198,8 +198,8 @@ CommandRegistrar registrar(
       app.add_option("--out", args->out, "output dataset folder (required)");
       app.add_option("--stats", args->stats,
                      "instead of simulating: realism statistics (range, intensity, ring, height, zero-intensity, BEV "
-                     "scatter and points-per-cell histograms; points on cars) of these KITTI-layout datasets or folders "
-                     "of .bin scans pooled, at most --frames frames from each")
+                     "scatter and points-per-cell histograms; points on cars) of these KITTI-layout datasets or "
+                     "folders of .bin scans pooled, at most --frames frames from each")
           ->check(CLI::ExistingDirectory);
       app.add_option("--compare", args->compare,
                      "instead of simulating: Wasserstein-1 distance per statistic between the --stats files of two "

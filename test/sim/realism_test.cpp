@@ -264,7 +264,8 @@ TEST(Realism, MountJitterKeepsBoxesOnTheirPoints) {
     int frame = 0, track = 0;
     std::string cls;
     Box b;
-    s >> frame >> track >> cls >> b.x >> b.y >> b.z >> b.length >> b.width >> b.height >> b.yaw >> b.vx >> b.vy >> b.num_points;
+    s >> frame >> track >> cls >> b.x >> b.y >> b.z >> b.length >> b.width >> b.height >> b.yaw >> b.vx >> b.vy >>
+        b.num_points;
     ASSERT_FALSE(s.fail()) << line;
     info.emplace_back(frame, b);
   }
