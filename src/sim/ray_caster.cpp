@@ -67,6 +67,7 @@ struct RayCaster::Impl {
   std::vector<ActorGeom> actors;
   std::vector<Eigen::Vector3f> dirs;  // per slot, LiDAR frame
   std::vector<float> col_time;
+  std::vector<std::uint8_t> ego_blocked;  // per slot: the ray passes through the ego's body
   int threads = 2;
 
   ~Impl() {
@@ -89,9 +90,14 @@ RayCaster::RayCaster(const SensorModel& sensor, int threads) : impl_(std::make_u
   const int cols = sensor_.columns(), beams = sensor_.beams();
   impl_->dirs.resize(static_cast<std::size_t>(cols) * beams);
   impl_->col_time.resize(cols);
+  impl_->ego_blocked.assign(impl_->dirs.size(), 0);
   for (int c = 0; c < cols; ++c) {
     impl_->col_time[c] = static_cast<float>(columnTime(c));
-    for (int b = 0; b < beams; ++b) impl_->dirs[static_cast<std::size_t>(c) * beams + b] = beamDirection(c, b).cast<float>();
+    for (int b = 0; b < beams; ++b) {
+      const Eigen::Vector3d d = beamDirection(c, b);
+      impl_->dirs[static_cast<std::size_t>(c) * beams + b] = d.cast<float>();
+      impl_->ego_blocked[static_cast<std::size_t>(c) * beams + b] = sensor_.blockedByEgoBody(d.x(), d.y(), d.z());
+    }
   }
 }
 
@@ -223,7 +229,7 @@ Sweep RayCaster::cast(const Eigen::Isometry3d& T, std::uint64_t seed, int frame,
         for (int b0 = 0; b0 < beams; b0 += 16) {
           for (int k = 0; k < 16; ++k) {
             const int b = b0 + k;
-            valid[k] = b < beams ? -1 : 0;
+            valid[k] = b < beams && !m.ego_blocked[static_cast<std::size_t>(c) * beams + b] ? -1 : 0;
             Eigen::Vector3d o(0, 0, 0), d(1, 0, 0);
             if (b < beams) slotRay(T, c, b, ego_velocity, yaw_rate, &o, &d);
             rh.ray.org_x[k] = static_cast<float>(o.x());
@@ -246,7 +252,7 @@ Sweep RayCaster::cast(const Eigen::Isometry3d& T, std::uint64_t seed, int frame,
             const int b = b0 + k;
             const std::size_t slot = static_cast<std::size_t>(c) * beams + b;
             sw.time[slot] = m.col_time[c];
-            if (rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) continue;
+            if (!valid[k] || rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) continue;
             const unsigned inst = rh.hit.instID[0][k];
             const unsigned prim = rh.hit.primID[k];
             Surface surf;
@@ -260,7 +266,7 @@ Sweep RayCaster::cast(const Eigen::Isometry3d& T, std::uint64_t seed, int frame,
               if (ag.surfaces && prim < ag.surfaces->size()) surf = (*ag.surfaces)[prim];
               ng = ag.pose.linear() * ng;  // Embree reports instanced normals in object space
             }
-            const double range = rh.ray.tfar[k];
+            double range = rh.ray.tfar[k];
             sw.hit[slot] = 1;
             sw.actor[slot] = actor;
             // Per-ray randomness from (seed, frame, slot): independent of threads and order.
@@ -272,12 +278,30 @@ Sweep RayCaster::cast(const Eigen::Isometry3d& T, std::uint64_t seed, int frame,
                                 (1.0 - sensor_.far_dropout * range / sensor_.max_range) *
                                 (cos_inc < 0.03 ? 0.0 : 1.0);
             if (rng.uniform() >= keep) continue;
+            if (surf.porosity > 0 && rng.uniform() < surf.porosity) {
+              // Into the crown: the return comes from a leaf at a random depth before the next surface.
+              const Eigen::Vector3d o(rh.ray.org_x[k], rh.ray.org_y[k], rh.ray.org_z[k]);
+              const Eigen::Vector3d wdir =
+                  Eigen::Vector3d(rh.ray.dir_x[k], rh.ray.dir_y[k], rh.ray.dir_z[k]).normalized();
+              double depth = kPorousDepth;
+              intersect(o + wdir * (range + 1e-3), wdir, 0.0, kPorousDepth, &depth, nullptr);
+              range += rng.uniform() * depth;
+            }
             const double r = range + sensor_.range_noise_sigma * rng.normal();
             if (r < sensor_.min_range || r > sensor_.max_range) continue;
             double inten = surf.reflectivity * std::pow(cos_inc, sensor_.incidence_exponent) *
                            std::exp(-sensor_.range_attenuation * range) * sensor_.intensity_gain +
                            sensor_.intensity_noise_sigma * rng.normal();
             inten = std::clamp(inten, 0.0, 1.0);
+            if (inten < sensor_.zero_intensity_below) inten = 0.0;
+            if (sensor_.zero_intensity_near > 0 || sensor_.zero_intensity_far > 0) {
+              const double ramp = std::clamp((r - sensor_.zero_intensity_near_range) /
+                                                 (sensor_.zero_intensity_far_range - sensor_.zero_intensity_near_range),
+                                             0.0, 1.0);
+              const double p0 =
+                  sensor_.zero_intensity_near + (sensor_.zero_intensity_far - sensor_.zero_intensity_near) * ramp;
+              if (rng.uniform() < p0) inten = 0.0;
+            }
             Point& p = sw.points[slot];
             p.x = static_cast<float>(d.x() * r);
             p.y = static_cast<float>(d.y() * r);

@@ -66,6 +66,7 @@ Surface drawSurface(const SimConfig& config, const std::string& material, Rng& r
   Surface s;
   s.reflectivity = static_cast<float>(std::clamp(rng.normal(m.reflectivity, m.sigma), 0.01, 1.0));
   s.dropout = static_cast<float>(m.dropout);
+  s.porosity = static_cast<float>(m.porosity);
   return s;
 }
 
@@ -512,6 +513,7 @@ void buildStaticGeometry(Scene& scene, const SimConfig& config, Rng& rng, double
   }
 
   // Clutter along both sides of every road: buildings with windows, walls or fences in the gaps, trees, poles, signs.
+  Rng extra(mix64(scene.noise_seed ^ 0x6865646765ULL));  // hedges, bushes, bollards
   for (std::size_t r = 0; r < scene.roads.size(); ++r) {
     const Road& road = scene.roads[r];
     const double L = road.center.length();
@@ -577,6 +579,69 @@ void buildStaticGeometry(Scene& scene, const SimConfig& config, Rng& rng, double
           }
         }
         s += f + draw(rng, cc.building_gap);
+      }
+      // Hedges along the sidewalk's outer edge, bushes beyond it, bollards at the curb (their own stream).
+      if (cc.hedge_probability > 0) {
+        for (double s = extra.uniform(0, 10); s < L;) {
+          const double f = draw(extra, cc.building_frontage);
+          if (extra.chance(cc.hedge_probability)) {
+            const double off = W + SW + 0.6, h = draw(extra, cc.hedge_height), depth = extra.uniform(0.7, 1.2);
+            const Surface leaves = drawSurface(config, "foliage", extra);
+            // In pieces of about 2 m, each checked on its own, so a hedge stops at cross roads and driveways.
+            for (double s0 = s; s0 + 0.5 < s + f; s0 += 2.0) {
+              const double s1 = std::min(s0 + 2.0, s + f);
+              const V2 a = road.center.at(s0).p + side * off * normalLeft(road.center.at(s0).yaw);
+              const V2 e = road.center.at(s1).p + side * off * normalLeft(road.center.at(s1).yaw);
+              Box b;
+              b.x = 0.5 * (a.x() + e.x());
+              b.y = 0.5 * (a.y() + e.y());
+              b.length = (e - a).norm();
+              b.width = depth;
+              b.yaw = std::atan2(e.y() - a.y(), e.x() - a.x());
+              if (!nearRoute(V2(b.x, b.y), 5) || !footprintFree(scene, b, 0.0, keep_out)) continue;
+              const double z0 = scene.groundHeight(b.x, b.y);
+              addWall(mesh, a, e, depth, z0 - 0.1, z0 + h, leaves);
+            }
+          }
+          s += f + extra.uniform(1, 6);
+        }
+      }
+      if (cc.bush_spacing.hi > 0) {
+        for (double s = extra.uniform(0, cc.bush_spacing.hi); s < L; s += std::max(0.5, draw(extra, cc.bush_spacing))) {
+          const PathPose pp = road.center.at(s);
+          const double r = draw(extra, cc.bush_radius);
+          const V2 p = pp.p + side * (W + SW + 0.3 + r + extra.uniform(0, 3)) * normalLeft(pp.yaw);
+          Box fb;
+          fb.x = p.x();
+          fb.y = p.y();
+          fb.length = fb.width = 2 * r;
+          if (!nearRoute(p, 5) || !footprintFree(scene, fb, 0.1, keep_out)) continue;
+          const double z0 = scene.groundHeight(p.x(), p.y());
+          mesh.addEllipsoid(poseAt(p, z0 + 0.6 * r, extra.uniform(0, M_PI)),
+                            V3f(static_cast<float>(r), static_cast<float>(r * extra.uniform(0.6, 1.0)),
+                                static_cast<float>(0.8 * r)),
+                            8, 5, drawSurface(config, "foliage", extra));
+        }
+      }
+      if (cc.bollard_spacing.hi > 0 && SW > 0) {
+        for (double s = extra.uniform(0, cc.bollard_spacing.hi); s < L;
+             s += std::max(0.5, draw(extra, cc.bollard_spacing))) {
+          const PathPose pp = road.center.at(s);
+          const V2 p = pp.p + side * (W + 0.3) * normalLeft(pp.yaw);
+          Box fb;
+          fb.x = p.x();
+          fb.y = p.y();
+          fb.length = fb.width = 0.3;
+          bool at_crossing = false;
+          if (road.main)
+            for (double c : scene.crossings) at_crossing = at_crossing || std::abs(c - s) < 4;
+          if (at_crossing || !nearRoute(p, 5) || scene.onOtherCarriageway(p, static_cast<int>(r), 0.5) ||
+              hitsKeepOut(keep_out, fb))
+            continue;
+          const double z0 = scene.groundHeight(p.x(), p.y()) + rc.curb_height;
+          mesh.addCylinder(poseAt(p, z0 - 0.1, 0), 0.08f, static_cast<float>(0.1 + extra.uniform(0.7, 1.1)), 6,
+                           drawSurface(config, "metal", extra));
+        }
       }
       // Trees.
       for (double s = rng.uniform(0, cc.tree_spacing.hi); s < L; s += draw(rng, cc.tree_spacing)) {

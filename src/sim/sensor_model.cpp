@@ -13,6 +13,26 @@ namespace sim {
 
 int SensorModel::columns() const { return static_cast<int>(std::lround(360.0 / azimuth_resolution_deg)); }
 
+bool SensorModel::blockedByEgoBody(double dx, double dy, double dz) const {
+  if (ego_body_box.size() != 6) return false;
+  // Slab test of the ray from the origin, t in [0, inf).
+  double t0 = 0, t1 = 1e30;
+  const double d[3] = {dx, dy, dz};
+  for (int a = 0; a < 3; ++a) {
+    const double lo = ego_body_box[2 * a], hi = ego_body_box[2 * a + 1];
+    if (std::abs(d[a]) < 1e-12) {
+      if (0 < lo || 0 > hi) return false;
+      continue;
+    }
+    double ta = lo / d[a], tb = hi / d[a];
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+    if (t0 > t1) return false;
+  }
+  return true;
+}
+
 namespace {
 
 [[noreturn]] void fail(const std::string& file, const std::string& key, const std::string& what) {
@@ -51,7 +71,10 @@ SensorModel loadSensorModel(const std::string& path) {
       {"range_noise_sigma", &s.range_noise_sigma},           {"dropout", &s.dropout},
       {"far_dropout", &s.far_dropout},                       {"incidence_exponent", &s.incidence_exponent},
       {"range_attenuation", &s.range_attenuation},           {"intensity_gain", &s.intensity_gain},
-      {"intensity_noise_sigma", &s.intensity_noise_sigma}};
+      {"intensity_noise_sigma", &s.intensity_noise_sigma},   {"zero_intensity_below", &s.zero_intensity_below},
+      {"zero_intensity_near", &s.zero_intensity_near},       {"zero_intensity_far", &s.zero_intensity_far},
+      {"zero_intensity_near_range", &s.zero_intensity_near_range},
+      {"zero_intensity_far_range", &s.zero_intensity_far_range}};
   for (const auto& kv : root) {
     const std::string key = kv.first.as<std::string>();
     const YAML::Node& v = kv.second;
@@ -67,6 +90,13 @@ SensorModel loadSensorModel(const std::string& path) {
       if (!v.IsSequence() || v.size() == 0) fail(path, key, "expected a list of angles");
       for (std::size_t i = 0; i < v.size(); ++i)
         s.elevation_deg.push_back(number(path, v[i], key + "[" + std::to_string(i) + "]", -90, 90));
+    } else if (key == "ego_body_box") {
+      if (!v.IsSequence() || (v.size() != 6 && v.size() != 0))
+        fail(path, key, "expected [x_min, x_max, y_min, y_max, z_min, z_max] or []");
+      for (std::size_t i = 0; i < v.size(); ++i)
+        s.ego_body_box.push_back(number(path, v[i], key + "[" + std::to_string(i) + "]", -100, 100));
+      for (int a = 0; a < static_cast<int>(s.ego_body_box.size()) / 2; ++a)
+        if (s.ego_body_box[2 * a] >= s.ego_body_box[2 * a + 1]) fail(path, key, "each min must be below its max");
     } else if (key == "elevation_blocks") {
       // [{from: 2.0, to: -8.33, beams: 32}, ...]: beams evenly spaced from `from` to `to` inclusive.
       if (!v.IsSequence() || v.size() == 0) fail(path, key, "expected a list of {from, to, beams}");
@@ -90,6 +120,11 @@ SensorModel loadSensorModel(const std::string& path) {
   if (s.max_range <= s.min_range || s.min_range < 0) fail(path, "max_range", "need 0 <= min_range < max_range");
   if (s.dropout < 0 || s.dropout > 1 || s.far_dropout < 0 || s.far_dropout > 1) fail(path, "dropout", "must be in [0, 1]");
   if (s.range_noise_sigma < 0 || s.intensity_noise_sigma < 0) fail(path, "range_noise_sigma", "must be >= 0");
+  if (s.zero_intensity_below < 0 || s.zero_intensity_below > 1) fail(path, "zero_intensity_below", "must be in [0, 1]");
+  if (s.zero_intensity_far < 0 || s.zero_intensity_far > 1) fail(path, "zero_intensity_far", "must be in [0, 1]");
+  if (s.zero_intensity_near < 0 || s.zero_intensity_near > 1) fail(path, "zero_intensity_near", "must be in [0, 1]");
+  if (s.zero_intensity_far_range <= s.zero_intensity_near_range)
+    fail(path, "zero_intensity_far_range", "must be above zero_intensity_near_range");
   // Ring 0 is the lowest beam.
   std::sort(s.elevation_deg.begin(), s.elevation_deg.end());
   return s;

@@ -114,6 +114,8 @@ SimConfig loadSimConfig(const std::string& path) {
       {"frame_rate", r.num(c.frame_rate, 0.5, 100)},
       {"label_range", r.num(c.label_range, 1, 500)},
       {"label_min_points", r.integer(c.label_min_points, 0, 1000000)},
+      {"mount_height_jitter", r.num(c.mount_height_jitter, 0, 0.5)},
+      {"mount_tilt_jitter_deg", r.num(c.mount_tilt_jitter_deg, 0, 5)},
       {"road", [&](const YAML::Node& n, const std::string& k) {
          r.map(n, k, {
              {"lanes_per_direction", r.integer(rd.lanes_per_direction, 1, 6)},
@@ -166,6 +168,11 @@ SimConfig loadSimConfig(const std::string& path) {
              {"sign_spacing", r.range(cl.sign_spacing, 1, big)},
              {"guard_rail", r.num(cl.guard_rail, 0, 1)},
              {"vegetation_setback", r.num(cl.vegetation_setback, 0, 100)},
+             {"hedge_probability", r.num(cl.hedge_probability, 0, 1)},
+             {"hedge_height", r.range(cl.hedge_height, 0.2, 5)},
+             {"bush_spacing", r.range(cl.bush_spacing, 0, big)},
+             {"bush_radius", r.range(cl.bush_radius, 0.1, 5)},
+             {"bollard_spacing", r.range(cl.bollard_spacing, 0, big)},
          });
        }},
       {"traffic", [&](const YAML::Node& n, const std::string& k) {
@@ -203,6 +210,7 @@ SimConfig loadSimConfig(const std::string& path) {
                {"reflectivity", r.num(m.reflectivity, 0, 1)},
                {"sigma", r.num(m.sigma, 0, 1)},
                {"dropout", r.num(m.dropout, 0, 1)},
+               {"porosity", r.num(m.porosity, 0, 1)},
            });
          }
        }},

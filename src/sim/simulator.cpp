@@ -32,6 +32,17 @@ SequenceReport simulateSequence(const SimOptions& opt, int index,
 
   Eigen::Isometry3d T_base_lidar = Eigen::Isometry3d::Identity();
   T_base_lidar.translation() = Eigen::Vector3d(sensor.mount_x, 0, sensor.mount_height);
+  if (cfg.mount_height_jitter > 0 || cfg.mount_tilt_jitter_deg > 0) {
+    // The sequence's mounting error, from its own stream so the scene and traffic stay those of the seed.
+    Rng mount(mix64(seq_seed ^ 0x6d6f756e74ULL));
+    const double deg = M_PI / 180.0;
+    T_base_lidar.translation().z() += mount.normal(0, cfg.mount_height_jitter);
+    const double pitch = mount.normal(0, cfg.mount_tilt_jitter_deg) * deg;
+    const double roll = mount.normal(0, cfg.mount_tilt_jitter_deg) * deg;
+    T_base_lidar.linear() =
+        (Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) * Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+            .toRotationMatrix();
+  }
 
   Scene scene;
   Traffic traffic(cfg, scene);

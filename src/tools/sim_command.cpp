@@ -7,6 +7,8 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "ret3d/core/progress.h"
 #include "ret3d/ros/kitti_bag.h"
@@ -19,7 +21,8 @@ namespace tools {
 namespace {
 
 struct SimArgs {
-  std::string config, out, sensor, replay, replay_sequence = "0000", stats, stats_out;
+  std::string config, out, sensor, replay, replay_sequence = "0000", stats_out;
+  std::vector<std::string> stats, compare;
   int sequences = 1, frames = 100, threads = 2;
   std::uint64_t seed = 0;
   bool bag = false;
@@ -42,17 +45,37 @@ int runStats(const SimArgs& args) {
                                   : std::filesystem::path(args.sensor).extension() == ".yaml"
                                       ? sim::loadSensorModel(args.sensor)
                                       : sim::sensorByName(args.sensor, root);
-  const sim::ScanStats s = sim::datasetStats(args.stats, sensor, args.frames);
+  sim::ScanStats s;
+  std::string names;
+  for (const auto& dir : args.stats) {
+    sim::addDataset(s, dir, sensor, args.frames);
+    names += (names.empty() ? "" : " + ") + dir;
+  }
+  s.finish();
   s.write(args.stats_out);
-  std::cout << args.stats << ": " << s.frames << " frames, " << fmt(static_cast<double>(s.points) / s.frames, 0)
+  const double zero = s.zero_hist.empty() ? 0.0 : s.zero_hist[0] / std::max(1e-9, s.zero_hist[0] + s.zero_hist[1]);
+  std::cout << names << ": " << s.frames << " frames, " << fmt(static_cast<double>(s.points) / s.frames, 0)
             << " points per frame, mean intensity " << fmt(s.mean_intensity, 3) << ", cars " << s.cars.size()
             << "; median points on a car at 10 m " << fmt(s.medianCarPoints(7, 13), 0) << ", 20 m "
-            << fmt(s.medianCarPoints(16, 24), 0) << ", 40 m " << fmt(s.medianCarPoints(33, 47), 0) << std::endl;
+            << fmt(s.medianCarPoints(16, 24), 0) << ", 40 m " << fmt(s.medianCarPoints(33, 47), 0)
+            << "; zero-intensity returns " << fmt(100 * zero, 1) << " %" << std::endl;
+  return 0;
+}
+
+// `--compare A B`: Wasserstein-1 distance per statistic between the --stats .dat files under prefixes A and B.
+int runCompare(const SimArgs& args) {
+  std::cout << "statistic   W1 (" << args.compare[0] << " vs " << args.compare[1] << ")\n";
+  for (const auto& d : sim::compareStats(args.compare[0], args.compare[1])) {
+    std::cout << d.name << std::string(d.name.size() < 12 ? 12 - d.name.size() : 1, ' ') << fmt(d.w1, 4)
+              << (d.unit.empty() ? "" : " " + d.unit) << "\n";
+  }
+  std::cout << std::flush;
   return 0;
 }
 
 int runSim(const SimArgs& args) {
   namespace fs = std::filesystem;
+  if (!args.compare.empty()) return runCompare(args);
   if (!args.stats.empty()) return runStats(args);
   if (args.config.empty() || args.out.empty()) throw std::runtime_error("--config and --out are required");
   sim::SimOptions opt;
@@ -174,9 +197,14 @@ CommandRegistrar registrar(
           ->check(CLI::ExistingFile);
       app.add_option("--out", args->out, "output dataset folder (required)");
       app.add_option("--stats", args->stats,
-                     "instead of simulating: realism statistics (range, intensity, ring histograms; points on cars) "
-                     "of this KITTI-layout dataset or folder of .bin scans, at most --frames frames")
+                     "instead of simulating: realism statistics (range, intensity, ring, height, zero-intensity, BEV "
+                     "scatter and points-per-cell histograms; points on cars) of these KITTI-layout datasets or "
+                     "folders of .bin scans pooled, at most --frames frames from each")
           ->check(CLI::ExistingDirectory);
+      app.add_option("--compare", args->compare,
+                     "instead of simulating: Wasserstein-1 distance per statistic between the --stats files of two "
+                     "--stats-out prefixes, e.g. --compare out/sim out/real")
+          ->expected(2);
       app.add_option("--stats-out", args->stats_out, "prefix of the --stats .dat files")->default_val("realism");
       app.add_option("--sequences", args->sequences, "number of sequences (seed + index each)")->capture_default_str();
       app.add_option("--frames", args->frames, "frames per sequence (replay: at most)")->capture_default_str();

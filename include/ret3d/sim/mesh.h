@@ -16,7 +16,11 @@ namespace sim {
 struct Surface {
   float reflectivity = 0.2f;
   float dropout = 0.0f;
+  // Probability that a ray entering this surface returns from inside the volume it bounds (tree crowns, hedges), at a
+  // depth drawn uniformly up to the next surface along the ray (at most kPorousDepth).
+  float porosity = 0.0f;
 };
+constexpr float kPorousDepth = 3.0f;  // m
 
 struct TriangleMesh {
   std::vector<Eigen::Vector3f> vertices;

@@ -28,10 +28,25 @@ struct SensorModel {
   double intensity_gain = 1.0;
   double intensity_noise_sigma = 0.03;
   bool motion_distortion = false;      // rays of one sweep leave from the pose at their own firing time
+  // Zero-intensity returns (real HDL-64E scans report reflectance 0 for 10-16 % of their returns: dark and far
+  // surfaces below the detector's threshold): a return whose intensity falls below `zero_intensity_below` keeps its
+  // point with intensity 0, and so does one drawn with a probability going linearly from `zero_intensity_near` up to
+  // `zero_intensity_near_range` (m) to `zero_intensity_far` from `zero_intensity_far_range` on. 0 = off.
+  double zero_intensity_below = 0.0;
+  double zero_intensity_near = 0.0;
+  double zero_intensity_far = 0.0;
+  double zero_intensity_near_range = 20.0;
+  double zero_intensity_far_range = 50.0;
+  // The ego car's body around the sensor, an axis-aligned box [x_min, x_max, y_min, y_max, z_min, z_max] in the
+  // LiDAR frame: rays passing through it return nothing (real scans' lowest beams hit the roof, hood and boot).
+  // Empty = no body.
+  std::vector<double> ego_body_box;
 
   int beams() const { return static_cast<int>(elevation_deg.size()); }
   int columns() const;                 // firings per revolution: round(360 / azimuth_resolution_deg)
   double period() const { return 1.0 / rotation_rate_hz; }
+  // Whether a ray from the sensor along `dir` (LiDAR frame) passes through ego_body_box.
+  bool blockedByEgoBody(double dx, double dy, double dz) const;
 };
 
 // Reads a sensor YAML; the beams are an explicit `elevation_deg` list or `elevation_blocks` of evenly spaced beams.

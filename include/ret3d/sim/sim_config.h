@@ -20,6 +20,7 @@ struct MaterialConfig {
   double reflectivity = 0.2;
   double sigma = 0.03;
   double dropout = 0.0;
+  double porosity = 0.0;  // Surface::porosity: returns scattered in depth inside the volume (vegetation)
 };
 
 struct RoadConfig {
@@ -70,6 +71,13 @@ struct ClutterConfig {
   Range sign_spacing{35, 90};
   double guard_rail = 0.0;              // 1: guard rails along the road edge (highway)
   double vegetation_setback = 0.0;      // trees this far beyond the sidewalk instead of in its furniture zone
+  // Roadside clutter real scans are full of (drawn from their own random stream, so the rest of the scene does not
+  // change when they are switched on): hedges along the sidewalk's outer edge, bushes beyond it, bollards at the curb.
+  double hedge_probability = 0.0;       // per frontage slot
+  Range hedge_height{0.8, 1.8};
+  Range bush_spacing{0, 0};             // along each side; 0..0 = none
+  Range bush_radius{0.4, 1.0};
+  Range bollard_spacing{0, 0};          // along each side; 0..0 = none
 };
 
 struct TrafficConfig {
@@ -99,6 +107,10 @@ struct SimConfig {
   double frame_rate = 10.0;
   double label_range = 80.0;            // objects beyond this distance are not labelled
   int label_min_points = 1;             // nor those with fewer returns
+  // Per-sequence mounting error of the sensor (Gaussian sigma; drawn from the sequence's own stream, labels stay in the
+  // tilted LiDAR frame): height (m) and pitch and roll (degrees).
+  double mount_height_jitter = 0.0;
+  double mount_tilt_jitter_deg = 0.0;
   RoadConfig road;
   GroundConfig ground;
   ClutterConfig clutter;
