@@ -1,4 +1,5 @@
-// `ret3d train detector --data DIR --config YAML --out MODEL [--resume]`: trains the LWD-3D base detector.
+// `ret3d train detector --data DIR --config YAML --out MODEL [--resume] [--gt-database FILE]`: trains the LWD-3D
+// base detector.
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -25,16 +26,21 @@ CommandRun setup(CLI::App& app) {
                  "start from this model's weights (same model config, or one that adds the IoU channels) with a fresh "
                  "optimiser and schedule; --resume still wins when <out>.ckpt exists")
       ->check(CLI::ExistingFile);
+  auto gt_database = std::make_shared<std::string>();
+  app.add_option("--gt-database", *gt_database,
+                 "ground-truth sampling database (`ret3d train gtdb`; overrides train.gt_database)")
+      ->check(CLI::ExistingFile);
   auto threads = std::make_shared<int>(0);
   app.add_option("--threads", *threads, "torch threads (default: the config's train.threads, else inference.threads)")
       ->check(CLI::PositiveNumber);
-  return [job, config, threads]() -> int {
+  return [job, config, threads, gt_database]() -> int {
     std::ifstream in(*config);
     std::stringstream ss;
     ss << in.rdbuf();
     job->config_text = ss.str();
     job->options = detectorOptionsFromYaml(job->config_text, *config);
     if (*threads > 0) job->options.train.threads = *threads;
+    if (!gt_database->empty()) job->options.train.sensor_augment.gt_database = *gt_database;
     const DetectorTrainResult r = trainDetector(*job);
     std::cout << "trained " << r.steps << " steps in " << r.seconds << " s, last epoch loss " << r.last_loss
               << ", model " << job->out_model << std::endl;
