@@ -120,7 +120,7 @@ struct SensorAugmentOptions {
   double intensity_zero_max = 0.2;
   // Intensity-free: with this probability every intensity becomes intensity_constant_value.
   double intensity_constant_probability = 0.0;
-  double intensity_constant_value = 0.3;
+  double intensity_constant_value = 0.25;
   // Previous-sweep dropout: with this probability the sample loses its previous sweep (as single KITTI object frames
   // have none); its velocity targets become invalid.
   double previous_dropout_probability = 0.0;
