@@ -71,7 +71,8 @@ DetectorTrainResult trainDetector(const DetectorTrainJob& job) {
     RET3D_INFO("ground-truth sampling from " << sensor_augment.databaseSize() << " objects of "
                                              << t.sensor_augment.gt_database);
   else if (!t.sensor_augment.gt_sample_counts.empty())
-    RET3D_INFO("train.gt_sample_counts without a database (train.gt_database, --gt-database): no ground-truth sampling");
+    RET3D_INFO("train.gt_sample_counts without a database (train.gt_database, --gt-database): "
+               "no ground-truth sampling");
 
   std::shared_ptr<nn::DetectorModel> model;
   Checkpoint ck;

@@ -29,7 +29,8 @@ Box makeBox(ObjectClass c, double x, double y, double yaw) {
 
 // Lattice steps: about 0.15 m across, 0.2 m up, a whole number of cells per side.
 Eigen::Vector3d latticeStep(const Box& b) {
-  return {b.length / std::ceil(b.length / 0.15), b.width / std::ceil(b.width / 0.15), b.height / std::ceil(b.height / 0.2)};
+  return {b.length / std::ceil(b.length / 0.15), b.width / std::ceil(b.width / 0.15),
+          b.height / std::ceil(b.height / 0.2)};
 }
 
 // Points at the lattice cells' centres, filling the box, intensity 0.6.
@@ -85,7 +86,9 @@ bool sameBoxes(const std::vector<Box>& a, const std::vector<Box>& b) {
   return true;
 }
 
-sim::SensorModel hdl64e() { return sim::loadSensorModel(std::string(RET3D_SOURCE_DIR) + "/config/sensors/hdl64e.yaml"); }
+sim::SensorModel hdl64e() {
+  return sim::loadSensorModel(std::string(RET3D_SOURCE_DIR) + "/config/sensors/hdl64e.yaml");
+}
 
 TEST(SensorAugment, WithEverythingOffTheSampleAndTheRandomStreamAreUnchanged) {
   const DetectorSample orig = makeSample(someBoxes(), {makeBox(ObjectClass::Car, -5, 12, 0)});
