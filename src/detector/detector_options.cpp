@@ -13,6 +13,13 @@ namespace ret3d {
 
 const char* headTypeName(HeadType h) { return h == HeadType::Anchor ? "anchor" : "center"; }
 
+bool SensorAugmentOptions::gtSamplingOn() const {
+  if (gt_database.empty()) return false;
+  for (const auto& [c, n] : gt_sample_counts)
+    if (n > 0) return true;
+  return false;
+}
+
 std::vector<int> ModelConfig::headStrides() const {
   std::vector<int> s = head == HeadType::Anchor ? anchor.strides : std::vector<int>{center.stride};
   std::sort(s.begin(), s.end());
@@ -241,6 +248,64 @@ void readInference(MapReader r, InferenceOptions* o) {
   if (o->threads < 1) r.fail(r.full("threads"), "must be >= 1");
 }
 
+// The sim-to-real augmentation keys (SensorAugmentOptions), directly under `train:`.
+void readSensorAugment(MapReader& r, SensorAugmentOptions* a) {
+  r.get("ray_drop_min", &a->ray_drop_min);
+  r.get("ray_drop_max", &a->ray_drop_max);
+  r.get("ray_drop_far", &a->ray_drop_far);
+  r.get("min_box_points", &a->min_box_points);
+  r.get("beam_subsample_probability", &a->beam_subsample_probability);
+  r.get("beam_subsample_keep_every", &a->beam_subsample_keep_every);
+  r.get("beam_sensor", &a->beam_sensor);
+  r.get("intensity_jitter_probability", &a->intensity_jitter_probability);
+  r.get("intensity_scale_min", &a->intensity_scale_min);
+  r.get("intensity_scale_max", &a->intensity_scale_max);
+  r.get("intensity_gamma_min", &a->intensity_gamma_min);
+  r.get("intensity_gamma_max", &a->intensity_gamma_max);
+  r.get("intensity_noise_sigma", &a->intensity_noise_sigma);
+  r.get("intensity_zero_probability", &a->intensity_zero_probability);
+  r.get("intensity_zero_max", &a->intensity_zero_max);
+  r.get("intensity_constant_probability", &a->intensity_constant_probability);
+  r.get("intensity_constant_value", &a->intensity_constant_value);
+  r.get("previous_dropout_probability", &a->previous_dropout_probability);
+  r.get("pose_z_range", &a->pose_z_range);
+  r.get("pose_tilt_deg", &a->pose_tilt_deg);
+  r.get("gt_database", &a->gt_database);
+  readClassValues(r, "gt_sample_counts", &a->gt_sample_counts);
+  r.get("gt_sample_margin", &a->gt_sample_margin);
+  auto within = [&](const char* key, double v, double lo, double hi) {
+    if (!(v >= lo && v <= hi))
+      r.fail(r.full(key), "must lie in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " +
+                              std::to_string(v));
+  };
+  for (const auto& [key, v] : {std::pair<const char*, double>{"ray_drop_min", a->ray_drop_min},
+                               {"ray_drop_max", a->ray_drop_max},
+                               {"ray_drop_far", a->ray_drop_far},
+                               {"beam_subsample_probability", a->beam_subsample_probability},
+                               {"intensity_jitter_probability", a->intensity_jitter_probability},
+                               {"intensity_zero_probability", a->intensity_zero_probability},
+                               {"intensity_zero_max", a->intensity_zero_max},
+                               {"intensity_constant_probability", a->intensity_constant_probability},
+                               {"intensity_constant_value", a->intensity_constant_value},
+                               {"previous_dropout_probability", a->previous_dropout_probability}})
+    within(key, v, 0.0, 1.0);
+  if (a->ray_drop_min > a->ray_drop_max) r.fail(r.full("ray_drop_min"), "must not exceed ray_drop_max");
+  if (a->min_box_points < 0) r.fail(r.full("min_box_points"), "must be >= 0");
+  if (a->beam_subsample_keep_every < 2) r.fail(r.full("beam_subsample_keep_every"), "must be >= 2");
+  if (a->beam_subsample_probability > 0 && a->beam_sensor.empty())
+    r.fail(r.full("beam_sensor"), "a sensor YAML is needed for beam_subsample_probability > 0");
+  within("intensity_scale_min", a->intensity_scale_min, 0.0, 10.0);
+  within("intensity_scale_max", a->intensity_scale_max, a->intensity_scale_min, 10.0);
+  within("intensity_gamma_min", a->intensity_gamma_min, 0.1, 10.0);
+  within("intensity_gamma_max", a->intensity_gamma_max, a->intensity_gamma_min, 10.0);
+  within("intensity_noise_sigma", a->intensity_noise_sigma, 0.0, 0.5);
+  within("pose_z_range", a->pose_z_range, 0.0, 1.0);
+  within("pose_tilt_deg", a->pose_tilt_deg, 0.0, 10.0);
+  within("gt_sample_margin", a->gt_sample_margin, 0.0, 5.0);
+  for (const auto& [c, n] : a->gt_sample_counts)
+    if (n < 0 || n > 100) r.fail(r.full("gt_sample_counts"), std::string(className(c)) + ": must lie in [0, 100]");
+}
+
 void readTrain(MapReader r, TrainOptions* t) {
   r.get("epochs", &t->epochs);
   r.get("batch_size", &t->batch_size);
@@ -265,6 +330,7 @@ void readTrain(MapReader r, TrainOptions* t) {
   r.get("loss_weight_regression", &t->loss_weight_regression);
   r.get("loss_weight_velocity", &t->loss_weight_velocity);
   r.get("loss_weight_iou", &t->loss_weight_iou);
+  readSensorAugment(r, &t->sensor_augment);
   r.finish();
   if (t->epochs < 1) r.fail(r.full("epochs"), "must be >= 1");
   if (t->batch_size < 1) r.fail(r.full("batch_size"), "must be >= 1");

@@ -33,7 +33,6 @@ void ScanStats::add(const PointCloud& cloud, const SensorModel& sensor, const st
   };
   std::unordered_map<std::int64_t, Cell> cells;
   cells.reserve(cloud.size() / 4);
-  const auto& el = sensor.elevation_deg;  // ascending
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const Point& p = cloud.points[i];
     const double h = std::hypot(p.x, p.y), r = std::sqrt(h * h + p.z * p.z);
@@ -58,10 +57,7 @@ void ScanStats::add(const PointCloud& cloud, const SensorModel& sensor, const st
     if (cloud.hasRing()) {
       ring = cloud.ring[i];
     } else {
-      const double e = std::atan2(p.z, h) * 180.0 / M_PI;
-      const auto it = std::lower_bound(el.begin(), el.end(), e);
-      ring = static_cast<std::size_t>(it - el.begin());
-      if (ring == el.size() || (ring > 0 && e - el[ring - 1] < el[ring] - e)) ring = ring > 0 ? ring - 1 : 0;
+      ring = static_cast<std::size_t>(std::max(0, nearestBeam(sensor, std::atan2(p.z, h) * 180.0 / M_PI)));
     }
     if (ring < ring_hist.size()) ring_hist[ring] += 1;
   }

@@ -33,6 +33,16 @@ bool SensorModel::blockedByEgoBody(double dx, double dy, double dz) const {
   return true;
 }
 
+int nearestBeam(const SensorModel& sensor, double elevation_deg) {
+  const auto& el = sensor.elevation_deg;  // ascending
+  if (el.empty()) return -1;
+  const auto it = std::lower_bound(el.begin(), el.end(), elevation_deg);
+  std::size_t ring = static_cast<std::size_t>(it - el.begin());
+  if (ring == el.size() || (ring > 0 && elevation_deg - el[ring - 1] < el[ring] - elevation_deg))
+    ring = ring > 0 ? ring - 1 : 0;
+  return static_cast<int>(ring);
+}
+
 namespace {
 
 [[noreturn]] void fail(const std::string& file, const std::string& key, const std::string& what) {

@@ -1,5 +1,5 @@
 // `ret3d train detector --data DIR... [--data-weights W...] [--labels-cover auto|all|camera...] --config YAML
-//  --out MODEL [--resume]`: trains the LWD-3D base detector.
+//  --out MODEL [--resume] [--gt-database FILE]`: trains the LWD-3D base detector.
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -39,10 +39,14 @@ CommandRun setup(CLI::App& app) {
                  "start from this model's weights (same model config, or one that adds the IoU channels) with a fresh "
                  "optimiser and schedule; --resume still wins when <out>.ckpt exists")
       ->check(CLI::ExistingFile);
+  auto gt_database = std::make_shared<std::string>();
+  app.add_option("--gt-database", *gt_database,
+                 "ground-truth sampling database (`ret3d train gtdb`; overrides train.gt_database)")
+      ->check(CLI::ExistingFile);
   auto threads = std::make_shared<int>(0);
   app.add_option("--threads", *threads, "torch threads (default: the config's train.threads, else inference.threads)")
       ->check(CLI::PositiveNumber);
-  return [job, config, threads, covers]() -> int {
+  return [job, config, threads, covers, gt_database]() -> int {
     for (const std::string& c : *covers) job->label_cover.push_back(labelCoverFromName(c));
     std::ifstream in(*config);
     std::stringstream ss;
@@ -50,6 +54,7 @@ CommandRun setup(CLI::App& app) {
     job->config_text = ss.str();
     job->options = detectorOptionsFromYaml(job->config_text, *config);
     if (*threads > 0) job->options.train.threads = *threads;
+    if (!gt_database->empty()) job->options.train.sensor_augment.gt_database = *gt_database;
     const DetectorTrainResult r = trainDetector(*job);
     std::cout << "trained " << r.steps << " steps in " << r.seconds << " s, last epoch loss " << r.last_loss
               << ", model " << job->out_model << std::endl;

@@ -17,6 +17,7 @@
 #include "ret3d/core/progress.h"
 #include "ret3d/detector/anchors.h"
 #include "ret3d/detector/nn/model.h"
+#include "ret3d/train/augmentations.h"
 #include "ret3d/train/detector_dataset.h"
 
 namespace ret3d {
@@ -95,6 +96,14 @@ DetectorTrainResult trainDetector(const DetectorTrainJob& job) {
                     << " % of an epoch" << std::defaultfloat);
   }
 
+  const SensorAugmenter sensor_augment(t.sensor_augment);
+  if (t.sensor_augment.gtSamplingOn())
+    RET3D_INFO("ground-truth sampling from " << sensor_augment.databaseSize() << " objects of "
+                                             << t.sensor_augment.gt_database);
+  else if (!t.sensor_augment.gt_sample_counts.empty())
+    RET3D_INFO("train.gt_sample_counts without a database (train.gt_database, --gt-database): "
+               "no ground-truth sampling");
+
   std::shared_ptr<nn::DetectorModel> model;
   Checkpoint ck;
   const std::string base = job.out_model;
@@ -161,6 +170,7 @@ DetectorTrainResult trainDetector(const DetectorTrainJob& job) {
         const std::size_t pos = static_cast<std::size_t>(b) * t.batch_size + k;
         if (pos >= order.size()) break;
         DetectorSample s = data.load(order[pos]);
+        sensor_augment.apply(&s, &rng);  // draws nothing while its options are off
         augmentSample(&s, t, &rng);
         const BevImage img = encoder.encode(s.current, s.has_previous ? &s.previous : nullptr, s.prev_to_current);
         inputs.push_back(nn::bevToTensor(img));

@@ -93,6 +93,52 @@ struct InferenceOptions {
   std::vector<double> grid_extent;
 };
 
+// Sim-to-real augmentation (include/ret3d/train/augmentations.h), applied to each training sample before the
+// LWD-3D ones; every part is off by default, and while off draws nothing from the sample's random generator.
+struct SensorAugmentOptions {
+  // Ray drop: each point of both sweeps is lost with probability p (uniform in [ray_drop_min, ray_drop_max] per
+  // sample) plus ray_drop_far * min(1, range / 80 m) (weak far returns); off when both are 0.
+  double ray_drop_min = 0.0, ray_drop_max = 0.0;
+  double ray_drop_far = 0.0;
+  // A box left with fewer points than this by ray drop or beam subsampling (and fewer than it had) becomes an
+  // ignore box: neither object nor background.
+  int min_box_points = 5;
+  // Beam subsampling: with this probability keep every k-th beam only (a 64-beam scan seen as a 32-beam one). The
+  // beam of a point is the beam of `beam_sensor` (a sensor YAML, relative to the working directory) whose elevation
+  // is nearest the point's, as KITTI scans carry no ring.
+  double beam_subsample_probability = 0.0;
+  int beam_subsample_keep_every = 2;
+  std::string beam_sensor = "config/sensors/hdl64e.yaml";
+  // Intensity jitter: with this probability i' = clamp(scale * i^gamma + N(0, sigma)), scale and gamma uniform.
+  double intensity_jitter_probability = 0.0;
+  double intensity_scale_min = 0.8, intensity_scale_max = 1.2;
+  double intensity_gamma_min = 0.8, intensity_gamma_max = 1.25;
+  double intensity_noise_sigma = 0.02;
+  // Zero intensity: with this probability a fraction uniform in [0, intensity_zero_max] of the points read exactly 0
+  // (real HDL-64E scans have 10-16 % such returns, the simulator < 1 %), far points preferred (weight ~ range).
+  double intensity_zero_probability = 0.0;
+  double intensity_zero_max = 0.2;
+  // Intensity-free: with this probability every intensity becomes intensity_constant_value.
+  double intensity_constant_probability = 0.0;
+  double intensity_constant_value = 0.25;
+  // Previous-sweep dropout: with this probability the sample loses its previous sweep (as single KITTI object frames
+  // have none); its velocity targets become invalid.
+  double previous_dropout_probability = 0.0;
+  // Sensor pose jitter: height offset uniform in +-pose_z_range (m), pitch and roll each uniform in
+  // +-pose_tilt_deg, about the sensor origin, points and boxes alike (boxes keep their yaw).
+  double pose_z_range = 0.0;
+  double pose_tilt_deg = 0.0;
+  // Ground-truth sampling (SECOND): a database written by `ret3d train gtdb` from training folders (or given by
+  // `ret3d train detector --gt-database`); up to gt_sample_counts objects per class are pasted per sample at their
+  // recorded range and elevation, rotated about the sensor's z axis, where their BEV box grown by gt_sample_margin
+  // (m) meets no other box. Off while the path is empty or no count is positive.
+  std::string gt_database;
+  std::vector<std::pair<ObjectClass, int>> gt_sample_counts;
+  double gt_sample_margin = 0.3;
+
+  bool gtSamplingOn() const;
+};
+
 struct TrainOptions {
   int epochs = 40;
   int batch_size = 4;
@@ -123,6 +169,7 @@ struct TrainOptions {
   double loss_weight_regression = 2.0;
   double loss_weight_velocity = 0.5;
   double loss_weight_iou = 1.0;   // the IoU-quality channels (anchor.iou_quality)
+  SensorAugmentOptions sensor_augment;  // its keys sit directly under `train:`
 };
 
 struct DetectorOptions {

@@ -49,6 +49,9 @@ struct SensorModel {
   bool blockedByEgoBody(double dx, double dy, double dz) const;
 };
 
+// The beam (ring) whose elevation is nearest `elevation_deg`, for scans without a ring (KITTI .bin); -1 without beams.
+int nearestBeam(const SensorModel& sensor, double elevation_deg);
+
 // Reads a sensor YAML; the beams are an explicit `elevation_deg` list or `elevation_blocks` of evenly spaced beams.
 // Throws std::runtime_error naming the file and key on bad input.
 SensorModel loadSensorModel(const std::string& path);
