@@ -31,7 +31,9 @@ Points downsample(const PointCloud& cloud, const ScanMatchingOptions& o) {
     if (p.z < o.ground_height || std::hypot(p.x, p.y) > o.max_range) continue;
     const Eigen::Vector3d v(p.x, p.y, p.z);
     const Eigen::Vector3i c = cellOf(v, o.voxel_size);
-    auto& cell = cells[voxelKey(c.x(), c.y(), c.z())];
+    // emplace, not operator[]: a default Eigen vector is uninitialised.
+    auto& cell =
+        cells.emplace(voxelKey(c.x(), c.y(), c.z()), std::make_pair(Eigen::Vector3d::Zero().eval(), 0)).first->second;
     cell.first += v, ++cell.second;
   }
   Points out;
