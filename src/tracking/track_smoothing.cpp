@@ -192,7 +192,8 @@ std::vector<std::vector<Box>> smoothTracks(const std::vector<std::vector<Box>>& 
     // The dominant heading: the axis of all observed headings (doubled-angle mean, score-weighted), pointing the way
     // the track moves when it moves at all, else the way most of its observations point.
     double s2 = 0, c2 = 0;
-    for (const Observation& o : obs) s2 += o.box.score * std::sin(2 * o.box.yaw), c2 += o.box.score * std::cos(2 * o.box.yaw);
+    for (const Observation& o : obs)
+      s2 += o.box.score * std::sin(2 * o.box.yaw), c2 += o.box.score * std::cos(2 * o.box.yaw);
     const double axis = 0.5 * std::atan2(s2, c2);
     double vote = 0;
     if (any_moving) {

@@ -50,7 +50,8 @@ TEST(ScanMatching, RecoversAKnownPlanarMotion) {
 
 TEST(ScanMatching, ReportsFailureWithoutStructure) {
   PointCloud ground;
-  for (int i = 0; i < 1000; ++i) ground.points.push_back({static_cast<float>(i % 40), static_cast<float>(i / 40), -1.73f, 0});
+  for (int i = 0; i < 1000; ++i)
+    ground.points.push_back({static_cast<float>(i % 40), static_cast<float>(i / 40), -1.73f, 0});
   EXPECT_FALSE(matchScans(ground, ground).converged);
 }
 
