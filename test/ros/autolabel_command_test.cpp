@@ -29,15 +29,26 @@ class AutolabelCommand : public ::testing::Test {
     seq_.write(tmp_ / "tracking", "0004", kScans, /*with_labels=*/false);
     fs::create_directories(tmp_ / "models");
     test::writeTinyModels(tmp_ / "models", RET3D_SOURCE_DIR);
+    // The untrained detector's scores are low: every box may start a track.
+    std::ifstream in(std::string(RET3D_SOURCE_DIR) + "/config/tracker.yaml");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    std::string yaml = ss.str();
+    for (const std::string key : {"score_threshold: 0.1", "birth_score: 0.75"}) {
+      const auto pos = yaml.find(key);
+      ASSERT_NE(pos, std::string::npos) << "config/tracker.yaml has no '" << key << "'";
+      yaml.replace(pos, key.size(), key.substr(0, key.find(':')) + ": 0.0");
+    }
+    std::ofstream(tmp_ / "tracker.yaml") << yaml;
   }
 
-  // `ret3d autolabel` on `data` into `out`; every box the untrained detector finds is kept and labelled.
+  // `ret3d autolabel` on `data` into `out`; every box the untrained detector finds is tracked, kept and labelled.
   int autolabel(const std::string& data, const std::string& out, std::string* output,
                 const std::vector<std::string>& extra = {}) {
     std::vector<std::string> command = {
         RET3D_CLI, "autolabel", "--data", data, "--out", out, "--models", tmp_ / "models", "--detector-config",
         tmp_ / "models/detector.yaml", "--threads", "1", "--score-threshold", "0", "--min-track-length", "1",
-        "--min-track-score", "0"};
+        "--min-track-score", "0", "--tracker-config", tmp_ / "tracker.yaml"};
     command.insert(command.end(), extra.begin(), extra.end());
     const std::string log = out + ".log";
     const int code = test::runLogged(command, log, 120.0);
@@ -49,7 +60,7 @@ class AutolabelCommand : public ::testing::Test {
   }
 
   // The written dataset as the detector trainer reads it.
-  void expectTrainable(const std::string& out, const std::string& seq) {
+  void expectTrainable(const std::string& out, const std::string& seq, const std::string& output) {
     const DetectorOptions options = loadDetectorOptions(tmp_ / "models/detector.yaml");
     const DetectorDataset ds(out, options.model);
     ASSERT_EQ(ds.size(), static_cast<std::size_t>(kScans));
@@ -57,7 +68,7 @@ class AutolabelCommand : public ::testing::Test {
     EXPECT_EQ(first.current.size(), seq_.scans[0].size()) << "the scans are linked, not rewritten";
     EXPECT_TRUE(second.has_previous);
     const auto labels = kitti::readTrackingLabels(out + "/training/label_02/" + seq + ".txt");
-    ASSERT_FALSE(labels.empty());
+    ASSERT_FALSE(labels.empty()) << output;
     for (const kitti::Label& l : labels) {
       ASSERT_TRUE(l.score.has_value());
       EXPECT_GE(l.track_id, 0);
@@ -75,7 +86,7 @@ TEST_F(AutolabelCommand, TrackingLayoutBecomesATrainableDataset) {
   ASSERT_EQ(autolabel(tmp_ / "tracking", tmp_ / "out", &output), 0) << output;
   EXPECT_NE(output.find("tracks"), std::string::npos) << output;
   EXPECT_NE(output.find("boxes per frame"), std::string::npos) << output;
-  expectTrainable(tmp_ / "out", "0004");
+  expectTrainable(tmp_ / "out", "0004", output);
   EXPECT_TRUE(fs::is_symlink(tmp_ / "out/training/velodyne/0004/000000.bin"));
 }
 
@@ -90,7 +101,7 @@ TEST_F(AutolabelCommand, ScanFolderGetsEstimatedPosesAndDefaultCalibration) {
   std::string output;
   ASSERT_EQ(autolabel(tmp_ / "scans", tmp_ / "out", &output), 0) << output;
   EXPECT_NE(output.find("ego motion estimated"), std::string::npos) << output;
-  expectTrainable(tmp_ / "out", "0000");
+  expectTrainable(tmp_ / "out", "0000", output);
   EXPECT_TRUE(kitti::readCalibration(tmp_ / "out/training/calib/0000.txt").P2.isApprox(kitti::defaultCalibration().P2));
 }
 
