@@ -166,8 +166,8 @@ std::vector<std::vector<Box>> smoothTracks(const std::vector<std::vector<Box>>& 
       const Observation* seen;  // null in a filled gap
     };
     std::vector<Frame> fits;
-    bool any_moving = false;
-    double motion_s = 0, motion_c = 0;  // summed motion directions, to orient the dominant heading
+    std::vector<double> speeds;
+    double motion_s = 0, motion_c = 0;  // summed motion directions of the moving frames, to orient the dominant heading
     for (const int t : targets) {
       Frame fr{t, {}, {}, nullptr};
       const Observation* before = nullptr;
@@ -182,21 +182,22 @@ std::vector<std::vector<Box>> smoothTracks(const std::vector<std::vector<Box>>& 
       if (fr.window.size() < 2 && !fr.seen && before && after) fr.window = {before, after};
       fr.fit = robustFit(fr.window, t, opt.outlier_distance);
       const Eigen::Vector2d v = fr.fit.velocity.head<2>() / opt.frame_period;
-      if (v.norm() > opt.moving_speed) {
-        any_moving = true;
-        motion_s += std::sin(std::atan2(v.y(), v.x())), motion_c += std::cos(std::atan2(v.y(), v.x()));
-      }
+      speeds.push_back(v.norm());
+      if (v.norm() > opt.moving_speed) motion_s += v.y() / v.norm(), motion_c += v.x() / v.norm();
       fits.push_back(std::move(fr));
     }
 
     // The dominant heading: the axis of all observed headings (doubled-angle mean, score-weighted), pointing the way
-    // the track moves when it moves at all, else the way most of its observations point.
+    // the track moves when it moves, else the way most of its observations point.
     double s2 = 0, c2 = 0;
     for (const Observation& o : obs)
       s2 += o.box.score * std::sin(2 * o.box.yaw), c2 += o.box.score * std::cos(2 * o.box.yaw);
     const double axis = 0.5 * std::atan2(s2, c2);
     double vote = 0;
-    if (any_moving) {
+    // Moving as a whole, by the median speed: a parked car's fit at the ends of its track can be fast by noise alone
+    // (one-sided windows), and its motion must not turn it around.
+    const bool moving = median(speeds) > opt.moving_speed;
+    if (moving) {
       vote = std::cos(std::atan2(motion_s, motion_c) - axis);
     } else {
       for (const Observation& o : obs) vote += o.box.score * (std::cos(o.box.yaw - axis) >= 0 ? 1.0 : -1.0);
@@ -208,10 +209,10 @@ std::vector<std::vector<Box>> smoothTracks(const std::vector<std::vector<Box>>& 
       b.x = fr.fit.centre.x(), b.y = fr.fit.centre.y(), b.z = fr.fit.centre.z();
       const Eigen::Vector2d v = fr.fit.velocity.head<2>() / opt.frame_period;
       b.vx = v.x(), b.vy = v.y();
-      if (v.norm() > opt.moving_speed)
+      if (moving && v.norm() > opt.moving_speed)
         b.yaw = alignedMean(fr.window, std::atan2(v.y(), v.x()));
       else
-        b.yaw = any_moving ? alignedMean(fr.window, dominant) : dominant;
+        b.yaw = moving ? alignedMean(fr.window, dominant) : dominant;
       b.num_points = fr.seen ? fr.seen->box.num_points : 0;
       if (!fr.seen) ++st.boxes_filled;
       out[static_cast<std::size_t>(fr.frame)].push_back(b);

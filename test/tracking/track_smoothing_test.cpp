@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -117,6 +118,29 @@ TEST(TrackSmoothing, StaticObjectKeepsItsDominantHeading) {
     EXPECT_LT(std::abs(wrapAngle(boxes.front().yaw - dominant)), 5.0 * M_PI / 180.0);
     EXPECT_LT(std::hypot(boxes.front().vx, boxes.front().vy), 1.0);
   }
+}
+
+// A parked car seen with noisy centres: the one-sided fits at its track's ends are fast by noise alone, and must not
+// turn it around.
+TEST(TrackSmoothing, NoisyParkedCarIsNotTurnedByItsEnds) {
+  std::mt19937 rng(5);
+  std::normal_distribution<double> centre(0.0, 0.3), heading(0.0, 0.03);
+  const double dominant = 3.1;
+  std::vector<std::vector<Box>> frames(16);
+  for (int f = 0; f < 16; ++f) {
+    Box b = truthAt(0);
+    b.x = -8 + centre(rng), b.y = 6 + centre(rng);
+    b.yaw = wrapAngle(dominant + heading(rng) + (f % 5 == 0 ? M_PI : 0.0));
+    frames[static_cast<std::size_t>(f)].push_back(b);
+  }
+  const auto out = smoothTracks(frames);
+  double fastest = 0;
+  for (const auto& boxes : out) {
+    ASSERT_EQ(boxes.size(), 1u);
+    EXPECT_LT(std::abs(wrapAngle(boxes.front().yaw - dominant)), 5.0 * M_PI / 180.0);
+    fastest = std::max(fastest, std::hypot(boxes.front().vx, boxes.front().vy));
+  }
+  EXPECT_GT(fastest, 1.0) << "the test needs an end fit faster than moving_speed";
 }
 
 TEST(TrackSmoothing, DropsWeakTracksAndRejectsBadOptions) {

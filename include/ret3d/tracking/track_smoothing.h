@@ -24,7 +24,8 @@ struct TrackSmoothingOptions {
   int max_gap = 5;
   // Observations farther than this (m) from the window's first fit are left out of the refit (outliers).
   double outlier_distance = 1.0;
-  // A frame whose fitted speed is above this (m/s) is moving: its heading agrees with the direction of motion.
+  // A track whose median fitted speed is above this (m/s) is moving: in its frames faster than this, the heading
+  // agrees with the direction of motion; in the others, and on static tracks, with the track's dominant heading.
   double moving_speed = 1.0;
   // Size: the median over this fraction of the track's observations with the most points (then the highest score).
   double size_fraction = 0.5;
