@@ -12,6 +12,9 @@ namespace ret3d {
 namespace kitti {
 namespace {
 
+// The one sequence of a plain folder of scans.
+const char* const kScanFolderSequence = "0000";
+
 // ROOT/training when it exists, else ROOT itself (the training folder was given).
 std::string resolveDir(const std::string& root) {
   std::error_code ec;
@@ -39,9 +42,13 @@ bool isFile(const std::string& p) {
 
 }  // namespace
 
-TrackingDataset::TrackingDataset(const std::string& root) : dir_(resolveDir(root)) {}
+TrackingDataset::TrackingDataset(const std::string& root) : dir_(resolveDir(root)) {
+  std::error_code ec;
+  scan_folder_ = !fs::is_directory(fs::path(dir_) / "velodyne", ec) && !stems(dir_, ".bin").empty();
+}
 
 std::vector<std::string> TrackingDataset::sequences() const {
+  if (scan_folder_) return {kScanFolderSequence};
   // A sequence may have scans without labels (test split, simulator output) or labels without scans (box-level data).
   std::set<std::string> seqs = stems(fs::path(dir_) / "velodyne", "");
   for (const auto& s : stems(fs::path(dir_) / "label_02", ".txt")) seqs.insert(s);
@@ -50,7 +57,8 @@ std::vector<std::string> TrackingDataset::sequences() const {
 
 std::vector<int> TrackingDataset::frames(const std::string& seq) const {
   std::vector<int> out;
-  for (const auto& s : stems(fs::path(dir_) / "velodyne" / seq, ".bin")) {
+  if (scan_folder_ && seq != kScanFolderSequence) return out;
+  for (const auto& s : stems(scan_folder_ ? fs::path(dir_) : fs::path(dir_) / "velodyne" / seq, ".bin")) {
     if (s.empty() || !std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; })) continue;
     out.push_back(std::stoi(s));
   }
@@ -61,6 +69,7 @@ std::vector<int> TrackingDataset::frames(const std::string& seq) const {
 std::string TrackingDataset::velodynePath(const std::string& seq, int frame) const {
   char name[32];
   std::snprintf(name, sizeof(name), "%06d.bin", frame);
+  if (scan_folder_) return (fs::path(dir_) / name).string();
   return (fs::path(dir_) / "velodyne" / seq / name).string();
 }
 
@@ -77,6 +86,11 @@ std::string TrackingDataset::oxtsPath(const std::string& seq) const {
   return (fs::path(dir_) / "oxts" / (seq + ".txt")).string();
 }
 bool TrackingDataset::hasLabels(const std::string& seq) const { return isFile(labelPath(seq)); }
+
+Calibration TrackingDataset::calibration(const std::string& seq) const {
+  if (scan_folder_ && !isFile(calibPath(seq))) return defaultCalibration();
+  return readCalibration(calibPath(seq));
+}
 
 std::vector<Eigen::Isometry3d> TrackingDataset::lidarPoses(const std::string& seq) const {
   // pose/ is the layout's primary ego-pose source (ARCHITECTURE.md); oxts/ is the fallback.

@@ -5,6 +5,12 @@ namespace io {
 
 bool forEachSweep(const kitti::TrackingDataset& ds, const std::string& seq, const std::function<void(const Sweep&)>& visit) {
   const auto poses = ds.lidarPoses(seq);
+  forEachSweep(ds, seq, poses, visit);
+  return !poses.empty();
+}
+
+void forEachSweep(const kitti::TrackingDataset& ds, const std::string& seq, const std::vector<Eigen::Isometry3d>& poses,
+                  const std::function<void(const Sweep&)>& visit) {
   auto pose = [&](int f) {
     return f >= 0 && f < static_cast<int>(poses.size()) ? poses[static_cast<std::size_t>(f)]
                                                         : Eigen::Isometry3d::Identity();
@@ -23,7 +29,6 @@ bool forEachSweep(const kitti::TrackingDataset& ds, const std::string& seq, cons
     previous = cloud;
     previous_frame = frame;
   }
-  return !poses.empty();
 }
 
 }  // namespace io

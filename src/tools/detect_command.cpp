@@ -140,7 +140,7 @@ std::size_t detectFromScans(const DetectArgs& a, OfflinePipeline* p) {
   std::vector<eval::VelocityFrame> velocity;  // labelled sequences: predictions beside the ground truth
   ProgressBar bar("detect", total_frames);
   for (const std::string& seq : seqs) {
-    const kitti::Calibration calib = kitti::readCalibration(ds.calibPath(seq));
+    const kitti::Calibration calib = ds.calibration(seq);
     const auto poses = ds.lidarPoses(seq);
     if (poses.empty()) {
       if (p->tracks()) throw std::runtime_error("sequence " + seq + ": no ego poses (pose/ or oxts/) for tracking");
@@ -245,7 +245,8 @@ CommandRegistrar reg("detect", "run the pipeline offline (base detector, IntraRM
                      [](CLI::App& app) -> CommandRun {
   auto a = std::make_shared<DetectArgs>();
   PipelineConfig& p = a->pipeline;
-  app.add_option("--data", a->data, "KITTI tracking or object root: scans for the base stage, calibration, poses")
+  app.add_option("--data", a->data, "KITTI tracking or object root (scans for the base stage, calibration, poses), or a "
+                 "plain folder of consecutive FFFFFF.bin scans (one sequence, 0000)")
       ->required();
   app.add_option("--detections", a->detections,
                  "without the base stage: input boxes (KITTI object/tracking result files or per-class CSV folders)");

@@ -78,6 +78,31 @@ TEST(TrackingDataset, FallsBackToOxts) {
   EXPECT_NEAR(poses[1].translation().x(), 10.0, 0.01);
 }
 
+TEST(TrackingDataset, PlainScanFolderIsOneSequence) {
+  TempDir tmp;
+  kitti::writeVelodyne(tmp / "000000.bin", tinyCloud());
+  kitti::writeVelodyne(tmp / "000001.bin", tinyCloud());
+  kitti::writeVelodyne(tmp / "000003.bin", tinyCloud());
+  std::ofstream(tmp / "README.txt") << "not a scan\n";
+  const kitti::TrackingDataset ds(tmp.path());
+  EXPECT_TRUE(ds.isScanFolder());
+  ASSERT_EQ(ds.sequences(), std::vector<std::string>{"0000"});
+  EXPECT_EQ(ds.frames("0000"), (std::vector<int>{0, 1, 3}));
+  EXPECT_TRUE(ds.frames("0001").empty());
+  EXPECT_EQ(kitti::readVelodyne(ds.velodynePath("0000", 3)).size(), 1u);
+  EXPECT_FALSE(ds.hasLabels("0000"));
+  EXPECT_TRUE(ds.lidarPoses("0000").empty());
+  EXPECT_TRUE(ds.calibration("0000").P2.isApprox(kitti::defaultCalibration().P2));
+}
+
+TEST(TrackingDataset, TrackingLayoutIsNoScanFolder) {
+  TempDir tmp;
+  makeTrackingLayout(tmp / "training");
+  const kitti::TrackingDataset ds(tmp.path());
+  EXPECT_FALSE(ds.isScanFolder());
+  EXPECT_THROW(ds.calibration("0005"), std::runtime_error);  // a tracking layout needs its calib/ file
+}
+
 TEST(TrackingDataset, MissingRootThrows) {
   TempDir tmp;
   EXPECT_THROW(kitti::TrackingDataset(tmp / "nowhere"), std::runtime_error);

@@ -151,6 +151,8 @@ std::vector<Eigen::Isometry3d> oxtsToLidarPoses(const std::vector<OxtsRecord>& r
 // Tracking layout: ROOT/training/{velodyne/SSSS/FFFFFF.bin, label_02/SSSS.txt, calib/SSSS.txt, pose/SSSS.txt,
 // oxts/SSSS.txt}. ROOT may also be the training folder itself. The constructors throw std::runtime_error when ROOT is
 // not a folder.
+// A plain folder of consecutive scans (ROOT/FFFFFF.bin, no velodyne/ subfolder), as a recorder or converter leaves
+// them, reads as one sequence "0000" without labels, calibration or poses.
 class TrackingDataset {
  public:
   explicit TrackingDataset(const std::string& root);
@@ -163,11 +165,15 @@ class TrackingDataset {
   std::string posePath(const std::string& seq) const;
   std::string oxtsPath(const std::string& seq) const;
   bool hasLabels(const std::string& seq) const;
+  bool isScanFolder() const { return scan_folder_; }  // the plain folder of scans above
+  // The sequence's calib/ file; for a scan folder without one, defaultCalibration() (its labels need a camera).
+  Calibration calibration(const std::string& seq) const;
   // LiDAR poses T_velo0_velo_t from pose/ (preferred) or oxts/; empty when neither exists.
   std::vector<Eigen::Isometry3d> lidarPoses(const std::string& seq) const;
 
  private:
   std::string dir_;
+  bool scan_folder_ = false;
 };
 
 // Object layout: ROOT/training/{velodyne,label_2,calib}/FFFFFF.{bin,txt}; ROOT may be the training folder itself.

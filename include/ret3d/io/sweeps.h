@@ -4,6 +4,7 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 #include <Eigen/Geometry>
 
@@ -23,6 +24,9 @@ struct Sweep {
 
 // Calls `visit` for every scan of `seq`; returns false when the sequence has no poses (motion taken as zero).
 bool forEachSweep(const kitti::TrackingDataset& ds, const std::string& seq, const std::function<void(const Sweep&)>& visit);
+// The same with the ego poses given (e.g. estimated from the scans): poses[frame], identity beyond them.
+void forEachSweep(const kitti::TrackingDataset& ds, const std::string& seq, const std::vector<Eigen::Isometry3d>& poses,
+                  const std::function<void(const Sweep&)>& visit);
 
 }  // namespace io
 }  // namespace ret3d
