@@ -111,7 +111,7 @@ DetectorOptions tinyOptions(HeadType head) {
   m.head = head;
   m.anchor.anchors_per_class = 1;
   auto& t = o.train;
-  t.epochs = 90;
+  t.epochs = 150;
   t.batch_size = 2;
   t.learning_rate = 4e-3;
   t.warmup_fraction = 0.05;
@@ -185,7 +185,7 @@ TEST_P(DetectorOverfitTest, ReachesNearPerfectAPOnItsTrainingFrames) {
   job.out_model = dir / "tiny.ret3d";
   job.options = tinyOptions(GetParam());
   // The centre head's sparse positives (one cell per object) need longer than the anchor head's three per anchor.
-  if (GetParam() == HeadType::Center) job.options.train.epochs = 150;
+  if (GetParam() == HeadType::Center) job.options.train.epochs = 240;
   job.config_text = "# overfit test\n";
   job.progress = false;
   const DetectorTrainResult r = trainDetector(job);
@@ -211,14 +211,41 @@ TEST_P(DetectorOverfitTest, ReachesNearPerfectAPOnItsTrainingFrames) {
           break;
         }
   }
+  // What must hold on any CPU and BLAS: every object is found where it is (its class within 0.3 m of its centre),
+  // the boxes overlap their objects well enough for AP at 3D IoU 0.5 to stay high, and few boxes are false.
+  // The floating-point order of the kernels (OpenBLAS and ATen pick them by CPU: AVX2, AVX-512, ...) changes the
+  // training trajectory. With the kernels forced to another CPU's (OPENBLAS_CORETYPE=Haswell or Zen with
+  // ATEN_CPU_CAPABILITY=avx2, i.e. an AVX2 machine without AVX-512) one cyclist frame of six fell just below
+  // 3D IoU 0.5 for both heads (Cyclist AP 0.833 / 0.806), while AVX-512 reached 1.0: six instances give AP steps of
+  // 1/6, so a per-class AP bar of 0.9 allowed no miss at all. Per class the bar is 0.75 (one tight box of six may
+  // fall below IoU 0.5); over all thirty objects AP at 3D IoU 0.5 must reach 0.9; and the centre-distance recall
+  // asserts that no object is missed.
+  std::vector<std::vector<Box>> all_dets = dets, all_gts = scene.boxes;
+  for (auto* frames : {&all_dets, &all_gts})
+    for (auto& frame : *frames)
+      for (Box& b : frame) b.label = ObjectClass::Car;  // one pool: AP over every object
+  int pooled_fp = 0;
+  const double pooled_ap = averagePrecision(all_dets, all_gts, ObjectClass::Car, &pooled_fp);
+  std::printf("  all objects AP(3D IoU 0.5) %.3f\n", pooled_ap);
+  EXPECT_GE(pooled_ap, 0.9);
   for (ObjectClass c : kDetectedClasses) {
     int fp = 0;
     const double ap = averagePrecision(dets, scene.boxes, c, &fp);
-    std::printf("  %s AP(3D IoU 0.5) %.3f, false positives %d\n", className(c), ap, fp);
-    // The centre head localises 0.7 x 0.6 m pedestrians from one 1 m cell (stride 4 at 0.25 m); after 450 steps
-    // its pedestrian AP at 3D IoU 0.5 was 0.83 (the rest 1.0), so that class is held to 0.75 for this head.
-    const double min_ap = GetParam() == HeadType::Center && c == ObjectClass::Pedestrian ? 0.75 : 0.9;
-    EXPECT_GE(ap, min_ap) << className(c);
+    int found = 0, total = 0;
+    for (int f = 0; f < kFrames; ++f)
+      for (const Box& g : scene.boxes[f]) {
+        if (g.label != c) continue;
+        ++total;
+        for (const Box& b : dets[f])
+          if (b.label == c && iou3d(b, g) >= 0.25) {
+            ++found;
+            break;
+          }
+      }
+    std::printf("  %s AP(3D IoU 0.5) %.3f, false positives %d, found %d of %d (3D IoU >= 0.25)\n", className(c), ap, fp,
+                found, total);
+    EXPECT_EQ(found, total) << className(c);
+    EXPECT_GE(ap, 0.75) << className(c);
     EXPECT_LE(fp, 3) << className(c);
   }
   ASSERT_FALSE(vel_err.empty());
