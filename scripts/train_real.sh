@@ -166,6 +166,16 @@ if ((n_train != 3712 || n_val != 3769)); then
   echo "$ME: warning: the split has $n_train train / $n_val val frames, not the standard 3,712 / 3,769" >&2
 fi
 
+# Those six frames are frames of the full set too: in its train half, a model learnt them, and scripts/real_scans.sh
+# (which evaluates on them) no longer measures it on unseen scans.
+if [ -d "$SHARED_KITTI/velodyne" ]; then
+  seen=$(comm -12 <(ids "$SPLIT_DIR/train.txt" | sort -u) \
+    <(find "$SHARED_KITTI/velodyne" -maxdepth 1 -name '*.bin' -printf '%f\n' | sed 's/\.bin$//' | sort -u) |
+    paste -sd ' ')
+  [ -z "$seen" ] || echo "$ME: note: frames $seen of the project's validation set ($SHARED_KITTI) are in" \
+                         "train.txt: scripts/real_scans.sh figures of this model are not on unseen scans" >&2
+fi
+
 mkdir -p "$OUT"
 OUT=$(realpath "$OUT")
 case "/$OUT/" in
