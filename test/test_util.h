@@ -7,6 +7,7 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace ret3d {
 namespace test {
@@ -23,6 +24,11 @@ inline std::optional<std::string> sharedDataDir() {
   if (fs::is_directory(p)) return fs::canonical(p).string();
   return std::nullopt;
 }
+
+// The six labelled KITTI object frames of ../shared/data/kitti_object/training: the project's real validation set.
+// The folder may hold more frames; tests that need these check they are there.
+inline const std::vector<std::string> kLabelledObjectFrames = {"000000", "000001", "000002",
+                                                               "000076", "000134", "001545"};
 
 inline constexpr const char* kSharedDataMissing =
     "../shared/data (real KITTI-derived data) is absent; set RET3D_SHARED_DATA to its location to run this test";

@@ -5,6 +5,7 @@
 #include <numeric>
 
 #include "ret3d/core/geometry.h"
+#include "assignment.h"
 #include "parallel.h"
 
 namespace ret3d {
@@ -38,70 +39,133 @@ struct ClassFrame {
   std::vector<double> iou;       // pred x gt
 };
 
-struct Scored {
+// The change of one frame's counts when the score cutoff comes down to `score`: the curve is their running sum.
+struct Step {
   double score;
-  bool tp;
-  double heading;
+  double tp, fp, heading;
 };
 
 double horizontalRange(const Box& b) { return std::hypot(b.x, b.y); }
 
-// Greedy matching of one frame under one configuration; appends every counted prediction to `out` and returns the
-// number of valid ground truth.
+// Hungarian assignment of some candidates to some valid ground truth (one connected part of their IoU graph),
+// maximising the total IoU of the pairs at or above the threshold. Sets, per candidate row, whether it is matched
+// and its heading accuracy.
+void assignPart(const ClassFrame& cf, const std::vector<std::size_t>& rows, const std::vector<std::size_t>& cols,
+                double threshold, std::vector<char>* matched, std::vector<double>* heading,
+                const std::vector<std::size_t>& candidates) {
+  const std::size_t ng = cf.gt.size(), nr = rows.size(), nc = cols.size();
+  std::vector<double> weight(nr * nc, 0.0);  // pairs under the threshold weigh nothing: never a match
+  for (std::size_t r = 0; r < nr; ++r) {
+    for (std::size_t c = 0; c < nc; ++c) {
+      const double o = cf.iou[candidates[rows[r]] * ng + cols[c]];
+      if (o >= threshold) weight[r * nc + c] = o;
+    }
+  }
+  const std::vector<int> assign = detail::maximiseAssignment(weight, static_cast<int>(nr), static_cast<int>(nc));
+  for (std::size_t r = 0; r < nr; ++r) {
+    const bool hit = assign[r] >= 0 && weight[r * nc + assign[r]] > 0;
+    (*matched)[rows[r]] = hit;
+    (*heading)[rows[r]] = hit ? headingAccuracy(cf.pred[candidates[rows[r]]]->yaw, cf.gt[cols[assign[r]]]->yaw) : 0.0;
+  }
+}
+
+int findRoot(std::vector<int>& parent, int i) {
+  while (parent[i] != i) i = parent[i] = parent[parent[i]];
+  return i;
+}
+
+// Waymo's matching of one frame under one configuration, at every cutoff among the frame's own prediction scores
+// (the curve's breakpoints: between them the frame's matching cannot change). At each, the candidates (counted
+// predictions at or above the cutoff reaching the threshold on some valid ground truth) are assigned anew, part by
+// part of their IoU graph: only the parts a new candidate joins can change. Appends the frame's steps to `out` and
+// returns the number of valid ground truth.
 int matchFrame(const ClassFrame& cf, const std::vector<char>& gt_valid, const std::vector<char>& pred_used,
-               double threshold, std::vector<Scored>& out) {
-  const std::size_t ng = cf.gt.size();
-  std::vector<char> taken(ng, 0);
+               double threshold, std::vector<Step>& out) {
+  const std::size_t ng = cf.gt.size(), np = cf.pred.size();
   int n_valid = 0;
   for (std::size_t g = 0; g < ng; ++g) n_valid += gt_valid[g];
-  for (std::size_t p = 0; p < cf.pred.size(); ++p) {
-    if (!pred_used[p]) continue;
-    int best = -1, best_ignored = -1;
-    double best_iou = threshold, best_ignored_iou = threshold;
-    for (std::size_t g = 0; g < ng; ++g) {
-      const double o = cf.iou[p * ng + g];
-      if (gt_valid[g]) {
-        if (!taken[g] && o >= best_iou) {
-          best_iou = o;
-          best = static_cast<int>(g);
-        }
-      } else if (o >= best_ignored_iou) {
-        best_ignored_iou = o;
-        best_ignored = static_cast<int>(g);
+  std::vector<std::size_t> candidates;  // prediction indices
+  std::vector<char> on_ignored, matched;  // per candidate
+  std::vector<double> heading;            // per candidate: its heading accuracy when matched
+  double unmatchable_fp = 0;              // counted predictions above the cutoff overlapping no ground truth
+  double tp = 0, fp = 0, h = 0;           // at the previous cutoff
+  for (std::size_t p = 0; p < np;) {
+    const double score = cf.pred[p]->score;
+    const std::size_t first_new = candidates.size();
+    for (; p < np && cf.pred[p]->score == score; ++p) {  // ties enter together
+      if (!pred_used[p]) continue;
+      bool valid = false, ignored = false;
+      for (std::size_t g = 0; g < ng; ++g) {
+        if (cf.iou[p * ng + g] < threshold) continue;
+        (gt_valid[g] ? valid : ignored) = true;
       }
+      if (valid) {
+        candidates.push_back(p);
+        on_ignored.push_back(ignored);
+        matched.push_back(0);
+        heading.push_back(0.0);
+      } else if (!ignored) {
+        unmatchable_fp += 1;
+      }  // else on an ignored box only: dropped
     }
-    if (best >= 0) {
-      taken[best] = 1;
-      out.push_back({cf.pred[p]->score, true, headingAccuracy(cf.pred[p]->yaw, cf.gt[best]->yaw)});
-    } else if (best_ignored < 0) {
-      out.push_back({cf.pred[p]->score, false, 0.0});
+    const std::size_t nc = candidates.size();
+    if (nc > first_new) {
+      // Parts of the graph: candidates are nodes [0, nc), ground truth g is node nc + g.
+      std::vector<int> parent(nc + ng);
+      std::iota(parent.begin(), parent.end(), 0);
+      for (std::size_t k = 0; k < nc; ++k) {
+        for (std::size_t g = 0; g < ng; ++g) {
+          if (gt_valid[g] && cf.iou[candidates[k] * ng + g] >= threshold)
+            parent[findRoot(parent, static_cast<int>(k))] = findRoot(parent, static_cast<int>(nc + g));
+        }
+      }
+      std::vector<char> redo(nc + ng, 0);
+      for (std::size_t k = first_new; k < nc; ++k) redo[findRoot(parent, static_cast<int>(k))] = 1;
+      std::vector<std::vector<std::size_t>> rows(nc + ng), cols(nc + ng);
+      for (std::size_t k = 0; k < nc; ++k) {
+        const int r = findRoot(parent, static_cast<int>(k));
+        if (redo[r]) rows[r].push_back(k);
+      }
+      for (std::size_t g = 0; g < ng; ++g) {
+        const int r = findRoot(parent, static_cast<int>(nc + g));
+        if (gt_valid[g] && redo[r]) cols[r].push_back(g);
+      }
+      for (std::size_t r = 0; r < nc + ng; ++r)
+        if (!rows[r].empty()) assignPart(cf, rows[r], cols[r], threshold, &matched, &heading, candidates);
     }
+    // A candidate left unmatched is a false positive unless it overlaps an ignored box (then dropped, as above).
+    double new_tp = 0, new_fp = unmatchable_fp, new_h = 0;
+    for (std::size_t k = 0; k < nc; ++k) {
+      new_tp += matched[k];
+      new_h += heading[k];
+      new_fp += !matched[k] && !on_ignored[k];
+    }
+    if (new_tp != tp || new_fp != fp || new_h != h) out.push_back({score, new_tp - tp, new_fp - fp, new_h - h});
+    tp = new_tp, fp = new_fp, h = new_h;
   }
   return n_valid;
 }
 
-WaymoCurve curveFrom(std::vector<Scored> dets, int num_gt) {
+WaymoCurve curveFrom(std::vector<Step> steps, int num_gt) {
   WaymoCurve c;
   c.num_gt = num_gt;
-  std::stable_sort(dets.begin(), dets.end(), [](const Scored& a, const Scored& b) { return a.score > b.score; });
+  std::stable_sort(steps.begin(), steps.end(), [](const Step& a, const Step& b) { return a.score > b.score; });
   double tp = 0, fp = 0, h = 0;
-  for (std::size_t i = 0; i < dets.size(); ++i) {
-    if (dets[i].tp) {
-      tp += 1;
-      h += dets[i].heading;
-    } else {
-      fp += 1;
-    }
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    tp += steps[i].tp;
+    fp += steps[i].fp;
+    h += steps[i].heading;
     // One curve point per distinct score: ties are cut together.
-    if (i + 1 < dets.size() && dets[i + 1].score == dets[i].score) continue;
+    if (i + 1 < steps.size() && steps[i + 1].score == steps[i].score) continue;
+    if (tp + fp <= 0) continue;
     const double n = std::max(1, num_gt);
     c.recall.push_back(tp / n);
     c.precision.push_back(tp / (tp + fp));
     c.recall_h.push_back(h / n);
     c.precision_h.push_back(h / (tp + fp));
   }
-  c.num_tp = static_cast<int>(tp);
-  c.num_fp = static_cast<int>(fp);
+  c.num_tp = static_cast<int>(std::lround(tp));
+  c.num_fp = static_cast<int>(std::lround(fp));
   if (num_gt > 0) {
     c.ap = interpolatedAp(c.recall, c.precision);
     c.aph = interpolatedAp(c.recall_h, c.precision_h);
@@ -160,7 +224,7 @@ WaymoResult evaluateWaymo(const std::vector<EvalFrame>& frames, const WaymoOptio
     detail::parallelFor(n_configs, options.threads, [&](std::size_t k) {
       const int level = static_cast<int>(k % kWaymoNumLevels);
       const int range = static_cast<int>(k / kWaymoNumLevels) - 1;  // -1: all ranges
-      std::vector<Scored> dets;
+      std::vector<Step> dets;
       int num_gt = 0;
       std::vector<char> valid, pred_used;
       for (const ClassFrame& cf : cfs) {

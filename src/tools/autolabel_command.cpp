@@ -251,7 +251,7 @@ CommandRegistrar reg("autolabel", "pseudo-labels for unlabelled sequences: pipel
   app.add_option("--intra-model", p.intra_model, "IntraRM model file (overrides --models)");
   app.add_option("--inter-model", p.inter_model, "InterRM model file (overrides --models)");
   app.add_option("--tracker-config", p.tracker_config,
-                 "tracker YAML (default: config/tracker.yaml's values, built in)");
+                 "tracker YAML (default: config/tracker_lwd3d_pipeline.yaml, as the nodelets)");
   app.add_option("--stages", a->stages, "comma-separated pipeline stages: base first, track or inter needed")
       ->capture_default_str();
   app.add_option("--score-threshold", p.score_threshold, "detector score threshold (default: the model's)");

@@ -328,7 +328,8 @@ CommandRegistrar reg("bench", "time the pipeline: through the nodelets on a bag,
   app.add_option("--inter-model", p.inter_model, "InterRM model file (overrides --models)");
   app.add_option("--detector-config", p.detector_config, "detector YAML (default: the config in the model file)");
   app.add_option("--tracker-config", p.tracker_config,
-                 "tracker YAML (default: built-in values; --bag: the one config/ret3d.yaml names)");
+                 "tracker YAML (default: config/tracker_lwd3d_pipeline.yaml with the base stage, as the "
+                 "nodelets; without it config/tracker.yaml's values, built in; --bag: the one config/ret3d.yaml names)");
   app.add_option("--score-threshold", p.score_threshold, "detector score threshold (default: the model's; --bag: config/ret3d.yaml's)");
   addGridExtentOption(app, &p.grid_extent);
   app.add_option("--stages", a->stages, "comma-separated stages in order, starting with base")->capture_default_str();

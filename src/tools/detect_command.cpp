@@ -260,7 +260,8 @@ CommandRegistrar reg("detect", "run the pipeline offline (base detector, IntraRM
   addGridExtentOption(app, &p.grid_extent);
   app.add_option("--intra-model", p.intra_model, "IntraRM model file (overrides --models)");
   app.add_option("--inter-model", p.inter_model, "InterRM model file (overrides --models)");
-  app.add_option("--tracker-config", p.tracker_config, "tracker YAML for track/inter (default: config/tracker.yaml's "
+  app.add_option("--tracker-config", p.tracker_config, "tracker YAML for track/inter (default: with the base stage "
+                 "config/tracker_lwd3d_pipeline.yaml, as the nodelets; with --detections config/tracker.yaml's "
                  "values, built in)");
   app.add_option("--sequences", a->sequences, "tracking sequences, e.g. 16-20 (default: all)");
   app.add_option("--out", a->out, "output folder for KITTI result files")->required();

@@ -9,7 +9,9 @@
 #include <CLI/CLI.hpp>
 
 #include "ret3d/detector/model_file.h"
+#include "ret3d/ros/params.h"
 #include "ret3d/tracking/tracker_options.h"
+#include "tools/tracker_default.h"
 
 namespace ret3d {
 namespace tools {
@@ -102,13 +104,19 @@ OfflinePipeline::OfflinePipeline(const PipelineConfig& c) : stages_(c.stages) {
     desc << "; InterRM " << o.model_path;
   }
   if (has(stages_, "track") || has(stages_, "inter")) {
-    TrackerOptions t = c.tracker_config.empty() ? TrackerOptions{} : loadTrackerOptions(c.tracker_config);
+    // Unset: the nodelets' config for the LWD-3D detector's probabilities; TrackerOptions' (PointRCNN) otherwise.
+    // (packagePath() asks rospack, which complains on stderr without the package: only when needed.)
+    const std::string config = !c.tracker_config.empty() ? c.tracker_config
+                               : hasBase()              ? defaultTrackerConfig(stages_, packagePath())
+                                                        : "";
+    TrackerOptions t = config.empty() ? TrackerOptions{} : loadTrackerOptions(config);
     // As in the ROS pipeline (the InterRM nodelet keeps max_history boxes per track), the history InterRM sees is
     // its model's max_history, whatever the tracker config says.
     if (inter_) t.history_length = inter_->arch().max_history;
     history_length_ = t.history_length;
     tracking_ = std::make_unique<train::TrackingRefiner>(t, inter_.get());
-    desc << "; tracker " << (c.tracker_config.empty() ? "built-in defaults" : c.tracker_config);
+    desc << "; tracker " << (config.empty() ? "built-in defaults (config/tracker.yaml's values)" : config);
+    if (c.tracker_config.empty()) desc << (config.empty() ? ", for external detections" : ", the base stage's default");
   }
   description_ = desc.str();
 }

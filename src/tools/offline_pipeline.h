@@ -28,7 +28,7 @@ struct PipelineConfig {
   std::string models;               // folder with detector.pt, intra_rm.pt, inter_rm.pt (the defaults below)
   std::string detector_model, intra_model, inter_model;  // explicit files win over --models
   std::string detector_config;      // YAML for the detector's inference options (default: those it was trained with)
-  std::string tracker_config;       // tracker YAML (default: the built-in values of config/tracker.yaml)
+  std::string tracker_config;       // tracker YAML; empty: defaultTrackerConfig(stages) (tools/tracker_default.h)
   double score_threshold = -1;      // >= 0: overrides the detector's inference.score_threshold
   std::vector<double> grid_extent;  // non-empty: overrides inference.grid_extent [x_min, x_max, y_min, y_max]
   int threads = 2;

@@ -108,7 +108,8 @@ TEST(KittiAp, ExactRecallSamplingForSmallSets) {
   frames[2].det = {scored(car(100, 150, 200, 250, -3, 10), 0.7)};
   KittiApOptions o;
   o.exact_recall = true;
-  const KittiCurve& c = carResult(evaluateKitti(frames, o)).curves[static_cast<int>(KittiMetric::Box3D)][0];
+  const KittiResult r = evaluateKitti(frames, o);  // kept: the curve is a reference into it
+  const KittiCurve& c = carResult(r).curves[static_cast<int>(KittiMetric::Box3D)][0];
   EXPECT_NEAR(c.ap40(), 100.0 * (10 + 10 * 2.0 / 3.0) / 40.0, 1e-9);
   EXPECT_NEAR(c.ap11(), 100.0 * (3 + 2) / 11.0, 1e-9);
 

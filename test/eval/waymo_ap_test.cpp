@@ -4,6 +4,8 @@
 
 #include <cmath>
 
+#include "ret3d/core/geometry.h"
+
 namespace ret3d {
 namespace eval {
 namespace {
@@ -98,6 +100,42 @@ TEST(WaymoAp, RangeBreakdown) {
   EXPECT_NEAR(carResult(r).ranges[1][0].ap, 0.0, 1e-9);
   EXPECT_EQ(carResult(r).ranges[2][0].num_gt, 0);
   EXPECT_NEAR(carResult(r).levels[0].ap, 50.0, 1e-9);  // (0.5, 1), (0.5, 0.5)
+}
+
+// Greedy and Hungarian matching differ. Cars along x (yaw 0): ground truth A at x = 0 and B at x = 1; prediction P1 (0.9) at x = 0.45
+// reaches the 0.7 threshold on both (IoU 0.798 with A, 0.758 with B), P2 (0.8) at x = -0.3 only on A (0.860; 0.509
+// with B). Greedy: P1 takes A, P2 finds A taken and is a FP: (0.5, 1), (0.5, 0.5) -> AP 50. Hungarian, at cutoff
+// 0.9: P1 - A, (0.5, 1); at cutoff 0.8: P1 - B and P2 - A (total IoU 1.618 > 0.798), (1, 1) -> AP 100.
+TEST(WaymoAp, HungarianMatchingGivesTheHigherScoredPredictionUpWhenThatMatchesMore) {
+  const std::vector<EvalFrame> frames = {
+      frameWith({car(0, 0, 100, 1, 0), car(1, 0, 100, 1, 0)}, {car(0.45, 0, 0, 0.9f, 0), car(-0.3, 0, 0, 0.8f, 0)})};
+  ASSERT_GE(iou3d(frames[0].pred_boxes[0], frames[0].gt_boxes[1]), 0.7);  // the premise: P1 could take either,
+  ASSERT_GT(iou3d(frames[0].pred_boxes[0], frames[0].gt_boxes[0]),         // greedy takes A
+            iou3d(frames[0].pred_boxes[0], frames[0].gt_boxes[1]));
+  ASSERT_LT(iou3d(frames[0].pred_boxes[1], frames[0].gt_boxes[1]), 0.7);  // P2 can only take A
+  const WaymoResult r = evaluateWaymo(frames);
+  const WaymoCurve& c = carResult(r).levels[0];
+  EXPECT_EQ(c.num_tp, 2);
+  EXPECT_EQ(c.num_fp, 0);
+  EXPECT_EQ(c.recall, (std::vector<double>{0.5, 1.0}));
+  EXPECT_EQ(c.precision, (std::vector<double>{1.0, 1.0}));
+  EXPECT_NEAR(c.ap, 100.0, 1e-9);
+  EXPECT_NEAR(c.aph, 100.0, 1e-9);  // same yaw everywhere
+}
+
+// The matching is redone at each cutoff. With a third prediction P3 (0.6) at x = 1.3 (IoU 0.860 with B, 0.509 with A),
+// the cutoff 0.6 assigns P2 - A and P3 - B (1.72) and P1 becomes the FP: (0.5, 1), (1, 1), (1, 2/3).
+TEST(WaymoAp, EachCutoffIsMatchedOnItsOwn) {
+  const std::vector<EvalFrame> frames = {frameWith(
+      {car(0, 0, 100, 1, 0), car(1, 0, 100, 1, 0)},
+      {car(0.45, 0, 0, 0.9f, 0), car(-0.3, 0, 0, 0.8f, 0), car(1.3, 0, 0, 0.6f, 0)})};
+  const WaymoResult r = evaluateWaymo(frames);
+  const WaymoCurve& c = carResult(r).levels[0];
+  EXPECT_EQ(c.num_tp, 2);
+  EXPECT_EQ(c.num_fp, 1);
+  EXPECT_EQ(c.recall, (std::vector<double>{0.5, 1.0, 1.0}));
+  EXPECT_NEAR(c.precision.back(), 2.0 / 3.0, 1e-12);
+  EXPECT_NEAR(c.ap, 100.0, 1e-9);
 }
 
 // A prediction on a Van (ignored for Car) is neither TP nor FP.

@@ -1,9 +1,14 @@
 // Waymo-style 3D detection AP and APH over 360 degrees, on LiDAR-frame boxes.
 //
-// - Matching: per frame and class, predictions in descending score order each take the unmatched ground truth of
-//   highest 3D IoU, if that IoU reaches the class threshold (0.7 Car, 0.5 Pedestrian, 0.5 Cyclist). A prediction
-//   whose best match is an ignored ground truth (a neighbouring class such as Van for Car, or a box of a harder level
-//   or another range bin) is dropped: neither true nor false positive.
+// - Matching, as the official Waymo metrics: per frame and class, at every score cutoff, the predictions at or above
+//   it are assigned to the ground truth by Hungarian assignment maximising the total 3D IoU of the pairs whose IoU
+//   reaches the class threshold (0.7 Car, 0.5 Pedestrian, 0.5 Cyclist). The cutoffs are the prediction scores
+//   themselves (a frame's matching changes only at its own scores), so a higher-scored prediction may give its
+//   ground truth up to a lower-scored one when that matches more pairs in total; greedy score-ordered matching
+//   (COCO/KITTI) never does. Ignored ground truth (a neighbouring class such as Van for Car, or a box of a harder
+//   level or another range bin) is not assigned; a prediction left unmatched that reaches the threshold on an ignored
+//   box is dropped: neither true nor false positive. (The official tool also assigns boxes of a harder level and
+//   drops what matches them; here valid ground truth comes first, as in KITTI's DontCare handling.)
 // - Heading accuracy of a true positive: 1 - |wrap(yaw_pred - yaw_gt)| / pi (1 when aligned, 0 when reversed).
 // - Levels from the points inside each ground-truth box: 0 points -> dropped (a prediction on it is a false
 //   positive, as the box is not in the ground truth at all); 1..5 -> LEVEL_2; more -> LEVEL_1. LEVEL_1 evaluates
@@ -11,8 +16,8 @@
 // - AP: the precision-recall curve over all score cutoffs, made monotone (precision at recall r = the maximum
 //   precision at any recall >= r), integrated exactly over recall (area under the step curve). APH uses the same
 //   rule on heading-weighted precision and recall (sum of heading accuracies over TP+FP and over the ground truth).
-//   The official Waymo tool uses a Hungarian matching at each of a fixed set of score cutoffs; the greedy
-//   score-ordered matching here is the COCO/KITTI convention and differs from it only in rare crowded ties.
+//   The official tool evaluates a fixed set of score cutoffs (configured, or quantiles of the scores); here every
+//   distinct score is one.
 #pragma once
 
 #include <array>
