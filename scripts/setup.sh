@@ -23,6 +23,8 @@ PACKAGES=(
   libdiagnostic-updater-dev libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
   # checks, plots, visual tests
   catkin-lint gnuplot-nox imagemagick rviz xvfb
+  # model-building scripts (scripts/fit_score_calibration.py)
+  python3-numpy
 )
 
 missing=()

@@ -9,7 +9,9 @@
 #      12 more epochs from its weights, both threads; the anchor head's adds IoU-quality channels, which start fresh)
 #      and a third (lwd3d_<head>_stage3.yaml, 6 more epochs at half the rate), each kept when it validates better;
 #      the best is installed as models/lwd3d/detector.pt. The inference options (box voting, IoU-score power, point
-#      refinement) were chosen on the tuning set and are written in the last stage's YAML.
+#      refinement) were chosen on the tuning set and are written in the last stage's YAML;
+#   5. (session 10) fine-tunes the result 4 epochs with sim-to-real augmentation and ground-truth sampling
+#      (config/detector/lwd3d_<head>_robust.yaml), kept when it validates better.
 # Resumable: run it again after a stop and it continues from the last checkpoint (every 5 minutes); finished steps
 # are skipped. On the idle 2-core machine about 55 minutes for the two heads, 40 for the second stage and 20 for the
 # third (112 in all; on a host slowed by other load, up to twice that). Work goes to data/ and out/train_default/.
@@ -72,15 +74,16 @@ model="$OUT/$best.pt"
 # budget, both threads: config/detector/lwd3d_<head>_stage2.yaml (12 more epochs from its weights, a warm restart of
 # the schedule), then lwd3d_<head>_stage3.yaml (6 more from stage 2's, half the rate, another seed). A stage's model
 # is installed when it validates better than the best so far.
-stage() {  # stage-name init-model
-  local name="${best_head}_$1"
+stage() {  # stage-name init-model [extra ret3d train detector options]
+  local name="${best_head}_$1" init=$2
+  shift 2
   [ -f "config/detector/lwd3d_$name.yaml" ] || return 0
   if [ ! -f "$OUT/$name.done" ]; then
     local t0
     t0=$(date +%s)
     ret3d train detector --data data/sim_train_urban data/sim_train_highway \
-      --config "config/detector/lwd3d_$name.yaml" --init "$2" --out "$OUT/$name.pt" \
-      --threads 2 --resume >"$OUT/train_$name.log" 2>&1
+      --config "config/detector/lwd3d_$name.yaml" --init "$init" --out "$OUT/$name.pt" \
+      --threads 2 --resume "$@" >"$OUT/train_$name.log" 2>&1
     touch "$OUT/$name.done"
     echo "$1 took $(( ($(date +%s) - t0) / 60 )) min (this run)"
   fi
@@ -91,5 +94,14 @@ stage() {  # stage-name init-model
 best_head=$best
 stage stage2 "$OUT/$best_head.pt"
 [ -f "$OUT/${best_head}_stage2.pt" ] && stage stage3 "$OUT/${best_head}_stage2.pt"
+# Session 10: a sim-to-real fine-tune (config/detector/lwd3d_<head>_robust.yaml: 4 epochs with ray drop, beam
+# subsampling, intensity changes, previous-sweep dropout, pose jitter and ground-truth sampling from a database of
+# the training sets' objects; models/lwd3d/MODEL_CARD.md). Its score calibration was refitted afterwards on the
+# relation set (scripts/fit_score_calibration.py) and written into that YAML.
+if [ -f "config/detector/lwd3d_${best_head}_robust.yaml" ] && [ -f "$OUT/${best_head}_stage3.pt" ]; then
+  [ -f data/gtdb/sim_train.gtdb ] || ret3d train gtdb --data data/sim_train_urban data/sim_train_highway \
+    --config "config/detector/lwd3d_${best_head}_robust.yaml" --out data/gtdb/sim_train.gtdb >"$OUT/gtdb.log" 2>&1
+  stage robust "$OUT/${best_head}_stage3.pt" --gt-database data/gtdb/sim_train.gtdb
+fi
 cp "$model" models/lwd3d/detector.pt
 echo "default detector: $model ($best; validation mean 3D AP R40 moderate $best_ap) -> models/lwd3d/detector.pt"
