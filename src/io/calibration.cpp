@@ -91,10 +91,11 @@ BevWedge imageRegionWedge(const Calibration& calib, double u_min, double u_max, 
                           double margin) {
   const Eigen::Matrix3d A = calib.P2.leftCols<3>();
   if (std::abs(A.determinant()) < 1e-12) throw std::invalid_argument("imageRegionWedge: P2 is singular");
-  const Eigen::Vector3d centre = -A.inverse() * calib.P2.col(3);  // camera 2's centre, rectified frame
+  const Eigen::Matrix3d A_inv = A.inverse();
+  const Eigen::Vector3d centre = -A_inv * calib.P2.col(3);  // camera 2's centre, rectified frame
   const Eigen::Vector2d apex = calib.rectToVelo(centre).head<2>();
   auto bevRay = [&](double u, double v) {
-    const Eigen::Vector3d d = A.inverse() * Eigen::Vector3d(u, v, 1.0);
+    const Eigen::Vector3d d = A_inv * Eigen::Vector3d(u, v, 1.0);
     return Eigen::Vector2d((calib.rectToVelo(centre + d).head<2>() - apex).normalized());
   };
   const Eigen::Vector2d mid = bevRay(0.5 * (u_min + u_max), 0.5 * (v_min + v_max));

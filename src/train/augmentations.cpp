@@ -216,8 +216,32 @@ void SensorAugmenter::apply(DetectorSample* s, std::mt19937* rng) const {
   }
 }
 
+namespace {
+
+// The objects pasted into one sweep, in order: each clears its region, then adds its points. Applied in one pass over
+// the sweep (not one per object): a scene point goes when any region holds it, an object's point when a later
+// object's region does, which is what clearing and adding one object after the other leaves.
+struct Pasted {
+  std::vector<GtRegion> cuts;
+  std::vector<std::vector<Point>> points;
+  void applyTo(PointCloud* cloud) const {
+    if (cuts.empty()) return;
+    keepPoints(cloud, [&](std::size_t, const Point& p) {
+      return std::none_of(cuts.begin(), cuts.end(), [&](const GtRegion& r) { return r.contains(p); });
+    });
+    for (std::size_t j = 0; j < points.size(); ++j)
+      for (const Point& p : points[j])
+        if (std::none_of(cuts.begin() + static_cast<std::ptrdiff_t>(j) + 1, cuts.end(),
+                         [&](const GtRegion& r) { return r.contains(p); }))
+          addPoint(cloud, p);
+  }
+};
+
+}  // namespace
+
 void SensorAugmenter::pasteObjects(DetectorSample* s, std::mt19937* rng) const {
   const GtDatabaseOptions region;
+  Pasted current, previous;
   std::uniform_real_distribution<double> U(0.0, 1.0);
   if (s->velocity_valid.size() != s->boxes.size()) s->velocity_valid.assign(s->boxes.size(), true);
   std::vector<Box> occupied = s->boxes;
@@ -247,19 +271,19 @@ void SensorAugmenter::pasteObjects(DetectorSample* s, std::mt19937* rng) const {
           break;
         }
       if (!free) continue;
-      auto paste = [&](PointCloud* cloud, const Box& at, const Eigen::Isometry3d& T) {
-        const GtRegion cut(at, region);
-        keepPoints(cloud, [&](std::size_t, const Point& p) { return !cut.contains(p); });
+      auto paste = [&](Pasted* into, const Box& at, const Eigen::Isometry3d& T) {
+        into->cuts.emplace_back(at, region);
+        into->points.emplace_back();
         for (const Point& p : g.points) {
           Point q = rotatedZ(p, c, sn);
           const Eigen::Vector3d v = T * Eigen::Vector3d(q.x, q.y, q.z);
           q.x = static_cast<float>(v.x()), q.y = static_cast<float>(v.y()), q.z = static_cast<float>(v.z());
-          addPoint(cloud, q);
+          into->points.back().push_back(q);
         }
       };
-      paste(&s->current, b, Eigen::Isometry3d::Identity());
+      paste(&current, b, Eigen::Isometry3d::Identity());
       // Into the previous sweep at the same place in the world: a parked object, velocity zero.
-      if (s->has_previous) paste(&s->previous, transformBox(b, current_to_previous), current_to_previous);
+      if (s->has_previous) paste(&previous, transformBox(b, current_to_previous), current_to_previous);
       b.vx = b.vy = 0;
       b.track_id = 0;
       s->boxes.push_back(b);
@@ -267,6 +291,8 @@ void SensorAugmenter::pasteObjects(DetectorSample* s, std::mt19937* rng) const {
       occupied.push_back(b);
     }
   }
+  current.applyTo(&s->current);
+  if (s->has_previous) previous.applyTo(&s->previous);
 }
 
 void SensorAugmenter::subsampleBeams(DetectorSample* s, int keep_every, int offset) const {

@@ -35,6 +35,14 @@ bool isIgnoredType(const ModelConfig& m, const std::string& type) {
 bool hasImageBox(const kitti::Label& l) { return l.bbox[2] > l.bbox[0] && l.bbox[3] > l.bbox[1]; }
 bool hasBox3d(const kitti::Label& l) { return l.h > 0 && l.w > 0 && l.l > 0; }
 
+// A DontCare label without a 3D box (KITTI gives none) becomes the region behind its image box; true when `l` was
+// such a label (and is no box).
+bool addDontCareRegion(const kitti::Label& l, const kitti::Calibration& calib, std::vector<BevWedge>* regions) {
+  if (l.type != "DontCare" || hasBox3d(l)) return false;
+  if (hasImageBox(l)) regions->push_back(kitti::imageRegionWedge(calib, l.bbox[0], l.bbox[2], l.bbox[1], l.bbox[3]));
+  return true;
+}
+
 }  // namespace
 
 // Accumulates what decides a set's label cover and the image size its labels imply.
@@ -166,11 +174,7 @@ void DetectorDataset::addTracking(std::size_t set, CoverEvidence* evidence) {
     for (const kitti::Label& l : labels) {
       if (l.frame < 0 || l.frame > last) continue;
       evidence->add(l);
-      if (l.type == "DontCare" && !hasBox3d(l)) {
-        if (hasImageBox(l))
-          s.dont_care[l.frame].push_back(kitti::imageRegionWedge(calib, l.bbox[0], l.bbox[2], l.bbox[1], l.bbox[3]));
-        continue;
-      }
+      if (addDontCareRegion(l, calib, &s.dont_care[l.frame])) continue;
       Box b = kitti::labelToBox(l, calib);
       s.boxes[l.frame].push_back(b);
       s.types[l.frame].push_back(l.type);
@@ -208,11 +212,7 @@ void DetectorDataset::addObject(std::size_t set, CoverEvidence* evidence) {
     s.dont_care.resize(1);
     for (const kitti::Label& l : kitti::readObjectLabels(ds.labelPath(name))) {
       evidence->add(l);
-      if (l.type == "DontCare" && !hasBox3d(l)) {
-        if (hasImageBox(l))
-          s.dont_care[0].push_back(kitti::imageRegionWedge(calib, l.bbox[0], l.bbox[2], l.bbox[1], l.bbox[3]));
-        continue;
-      }
+      if (addDontCareRegion(l, calib, &s.dont_care[0])) continue;
       s.boxes[0].push_back(kitti::labelToBox(l, calib));
       s.types[0].push_back(l.type);
     }
