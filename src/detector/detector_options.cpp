@@ -232,6 +232,7 @@ void readInference(MapReader r, InferenceOptions* o) {
     p.get("hidden_midpoint", &o->point_refine.hidden_midpoint);
     p.get("grow", &o->point_refine.grow);
     p.get("heading_search_deg", &o->point_refine.heading_search_deg);
+    p.get("heading_any", &o->point_refine.heading_any);
     p.get("heading_step_deg", &o->point_refine.heading_step_deg);
     p.get("heading_min_points", &o->point_refine.heading_min_points);
     readClassValues(p, "score_calibration", &o->point_refine.score_calibration);

@@ -31,6 +31,7 @@ void PointRefineOptions::validate() const {
   if (!(max_shift >= 0 && max_shift < 5)) fail("max_shift", "must lie in [0, 5) m");
   if (min_points < 1) fail("min_points", "must be >= 1");
   if (!(heading_search_deg >= 0 && heading_search_deg < 45)) fail("heading_search_deg", "must lie in [0, 45) deg");
+  if (heading_any && !(heading_search_deg > 0)) fail("heading_any", "needs heading_search_deg > 0");
   if (!(heading_step_deg > 0 && heading_step_deg <= 10)) fail("heading_step_deg", "must lie in (0, 10] deg");
   if (heading_min_points < 3) fail("heading_min_points", "must be >= 3");
   for (const auto& [c, w] : score_calibration) {
@@ -127,6 +128,23 @@ void refineTop(const PointRefineOptions& o, std::vector<double>* z, Box* b) {
   b->z = bottom + 0.5 * b->height;
 }
 
+// heading_any: 0 or a quarter turn, whichever makes the returns' extents (2 % - 98 % quantiles, less a surface
+// allowance) along and across the fitted heading fit within the network's length and width; when both fit, or
+// neither does better, the one nearer the network's heading (0 when the fit stayed within 45 deg of it).
+double lengthAxisTurn(const std::vector<double>& x, const std::vector<double>& y, double yaw, const Box& b) {
+  constexpr double kAllowance = 0.15;  // m: range noise and mirrors beyond the box the labeller drew
+  const double c = std::cos(yaw), s = std::sin(yaw);
+  std::vector<double> along(x.size()), across(x.size());
+  for (std::size_t i = 0; i < x.size(); ++i) along[i] = x[i] * c + y[i] * s, across[i] = -x[i] * s + y[i] * c;
+  auto extent = [](std::vector<double>* v) { return quantileOf(v, 0.98) - quantileOf(v, 0.02) - kAllowance; };
+  const double e_along = extent(&along), e_across = extent(&across);
+  auto overflow = [&](double e_length, double e_width) {
+    return std::max(0.0, e_length - b.length) + std::max(0.0, e_width - b.width);
+  };
+  const double keep = overflow(e_along, e_across), turn = overflow(e_across, e_along);
+  return turn + 1e-9 < keep ? 0.5 * M_PI : 0.0;
+}
+
 // The heading that best fits the outline of the returns within half a length (plus the margin) of the centre, from
 // the network's heading +- heading_search_deg (see heading_search_deg in the header).
 double fitHeading(const PointCloud& cloud, const CellIndex& index, const PointRefineOptions& o, const Box& b) {
@@ -156,12 +174,14 @@ double fitHeading(const PointCloud& cloud, const CellIndex& index, const PointRe
     for (double& v : *c) v = to_min <= to_max ? v - cmin : cmax - v;
   };
   const double step = o.heading_step_deg * M_PI / 180.0;
-  const int steps = static_cast<int>(std::floor(o.heading_search_deg / o.heading_step_deg));
+  // heading_any: [-45, 45) deg around the network's covers every outline (it repeats each quarter turn).
+  const int steps = static_cast<int>(std::floor((o.heading_any ? 45.0 : o.heading_search_deg) / o.heading_step_deg));
+  const int last = o.heading_any ? steps - 1 : steps;
   // The best score's first run of steps: every return within d0 of a face scores the same, so the score is flat
   // over a few steps around the true heading, whose middle is taken.
   int best_lo = 0, best_hi = 0;
   double best_score = -1;
-  for (int k = -steps; k <= steps; ++k) {
+  for (int k = -steps; k <= last; ++k) {
     const double yaw = b.yaw + k * step, c = std::cos(yaw), s = std::sin(yaw);
     for (std::size_t i = 0; i < n; ++i) c1[i] = x[i] * c + y[i] * s, c2[i] = -x[i] * s + y[i] * c;
     toFace(&c1), toFace(&c2);
@@ -172,7 +192,9 @@ double fitHeading(const PointCloud& cloud, const CellIndex& index, const PointRe
     else if (score >= best_score * (1 - 1e-9) && k == best_hi + 1)
       best_hi = k;
   }
-  return wrapAngle(b.yaw + 0.5 * (best_lo + best_hi) * step);
+  const double fitted = b.yaw + 0.5 * (best_lo + best_hi) * step;
+  if (!o.heading_any) return wrapAngle(fitted);
+  return wrapAngle(fitted + lengthAxisTurn(x, y, fitted, b));
 }
 
 bool refineFaces(const PointCloud& cloud, const CellIndex& index, const PointRefineOptions& o, BoxReturns* r,

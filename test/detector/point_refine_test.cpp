@@ -154,6 +154,38 @@ TEST(PointRefine, FitsTheHeadingToTheOutlineOfTheReturns) {
   EXPECT_DOUBLE_EQ(boxes[0].yaw, off.yaw);
 }
 
+// The difference of two headings as box axes (mod 180 deg), in [0, pi/2].
+double axisError(double a, double b) {
+  const double d = std::abs(std::remainder(a - b, M_PI));
+  return std::min(d, M_PI - d);
+}
+
+TEST(PointRefine, HeadingAnyTurnsABoxLyingAcrossTheCar) {
+  PointRefineOptions o = carsOnly();
+  o.heading_search_deg = 7.5;
+  o.heading_any = true;
+  // The axis error (deg) of the refined box of the car `truth` when the network's heading is `off` radians away.
+  auto errorDeg = [&](const Box& truth, double off) {
+    Box guess = truth;
+    guess.yaw += off;
+    std::vector<Box> boxes = {guess};
+    refineBoxesFromPoints(visibleFaces(truth), &boxes, o);
+    return axisError(boxes[0].yaw, truth.yaw) * 180 / M_PI;
+  };
+  // A car seen from the side and the rear (an L), the network's box a quarter turn plus 10 degrees off: the L fixes
+  // the axes, and the 4.4 m side, longer than the box's width, is the length.
+  const Box l_shape = carBox(12, 6, 0.3);
+  EXPECT_LT(errorDeg(l_shape, M_PI / 2 + 0.17), 1.0);
+  // Seen broadside only (one 4.4 m face), 60 degrees off: turned onto the face.
+  EXPECT_LT(errorDeg(carBox(0.2, 12, 0.0), 1.05), 1.0);
+  // Seen end-on (one 1.8 m rear face, which fits the box either way), 30 degrees off: aligned with the face, the
+  // axis nearer the network's kept, not turned across.
+  EXPECT_LT(errorDeg(carBox(15, 0.2, 0.0), 0.52), 1.0);
+  // Without heading_any, the search stays within heading_search_deg of the network's.
+  o.heading_any = false;
+  EXPECT_GT(errorDeg(l_shape, M_PI / 2 + 0.17), 60.0);
+}
+
 TEST(PointRefine, SetsTheTopFromTheHighestReturnsAndKeepsTheBottom) {
   const Box truth = carBox(8, -7, -1.2, 4.0, 1.7, 1.62);
   PointCloud cloud = visibleFaces(truth);
@@ -353,7 +385,7 @@ TEST(PointRefine, OptionsAreReadFromYamlAndMistakesRefused) {
   for (const std::string bad : {"faces: [Truck]", "centroid: {Truck: 0.1}", "centroid: {Car: 0.1}, faces: [Car]",
                                 "centroid: {Pedestrian: 3}", "quantile: 0", "quantile: 1.5", "min_points: 0", "margn: 0.3",
                                 "max_shift: -1", "heading_search_deg: 50",
-                                "heading_step_deg: 0", "heading_min_points: 2",
+                                "heading_step_deg: 0", "heading_min_points: 2", "heading_any: true",
                                 "score_calibration: {Car: [1, 2]}", "score_calibration: {Truck: [0, 1, 0, 0, 0, 0, 0, 0, 0]}",
                                 "score_calibration: {Car: [0, .nan, 0, 0, 0, 0, 0, 0, 0]}", "score_calibration: [1, 2]"}) {
     try {

@@ -6,7 +6,8 @@
 //   Faces hidden from the sensor keep the network's estimate, except with hidden_midpoint: along an axis whose two
 //   faces are both hidden (a car seen end-on), the visible face spans the car, and its returns centre the box; and
 //   with grow, a size grows (the visible face staying) to hold returns seen beyond the far face.
-//   With heading_search_deg, a car's heading is first fitted to the outline of its returns (an L-shape fit).
+//   With heading_search_deg, a car's heading is first fitted to the outline of its returns (an L-shape fit); with
+//   heading_any, over every heading.
 // - centroid (small classes: pedestrians, cyclists): the box centre is put at the centroid of its returns moved away
 //   from the sensor by a per-class offset (the visible surface lies in front of the centre; measured on training
 //   data), twice, so that the returns are re-selected around the moved box.
@@ -47,6 +48,12 @@ struct PointRefineOptions {
   // (2017, "Efficient L-shape fitting for vehicle detection using laser scanners"): the returns should lie close to
   // one of the two faces of each axis. 0 = the network's heading is kept.
   double heading_search_deg = 0.0;
+  // faces: the search covers every heading (a quarter turn, centred on the network's), and which of the outline's
+  // two axes is the length is then chosen from the returns: the one along which the returns fit within the network's
+  // length and width (a side seen longer than the box is wide is a side); when both fit (a rear face, a short L), the
+  // axis nearer the network's heading. For real scans, where the network's heading of a car is often a quarter turn
+  // or tens of degrees off while its returns' outline is sharp. Needs heading_search_deg > 0 for the step count.
+  bool heading_any = false;
   double heading_step_deg = 1.0;
   int heading_min_points = 10;     // fewer returns: the network's heading is kept
   // Score calibration, per class: after the refinement a box's score becomes sigmoid(w . f) with the features

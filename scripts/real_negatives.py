@@ -1,0 +1,133 @@
+#!/usr/bin/python3
+"""Labels for teaching real backgrounds (walls, poles, vegetation) to the detector from unlabelled real scans.
+
+Input: an object-layout folder ROOT/training/{velodyne,calib} of real scans, and the detector's boxes on them at a low
+score threshold (`ret3d detect --data ROOT --stages base --score-threshold 0.05 --out PRED`). Output: ROOT/training/
+label_2, one file per scan, for `ret3d train detector --data ROOT --labels-cover all`:
+
+- a pedestrian or cyclist box embedded in a larger structure (returns all along its sides: a wall, a hedge, a fence, a
+  trunk in foliage) or under returns higher than any such object (a tree, a pole with a sign, a building's edge) is
+  left out: its place is taught as background, which is what the detector gets wrong on real scans;
+- every other box becomes a DontCare box (grown by --grow m): it may be a real object the detector half sees, and
+  an unlabelled object must not be taught as background (the training masks DontCare boxes);
+- nothing is written as an object: objects come from the simulated folders trained beside, and from ground-truth
+  sampling, which pastes them into these real scenes.
+
+Usage: scripts/real_negatives.py ROOT PRED [--grow 0.3] [--min-score 0.1]
+Prints how many boxes per class became background and DontCare.
+"""
+import argparse
+import glob
+import math
+import os
+import sys
+
+import numpy as np
+
+
+def read_calib(path):
+    m = {}
+    for line in open(path):
+        if ":" not in line:
+            continue
+        k, v = line.split(":", 1)
+        m[k.strip()] = np.array([float(x) for x in v.split()])
+    r0 = np.eye(4)
+    r0[:3, :3] = m["R0_rect"].reshape(3, 3)
+    tr = np.eye(4)
+    tr[:3, :4] = m["Tr_velo_to_cam"].reshape(3, 4)
+    return np.linalg.inv(r0 @ tr)  # camera (rectified) -> velodyne
+
+
+def read_boxes(path, cam_to_velo):
+    """KITTI result lines -> (class, score, x, y, z_bottom, l, w, h, yaw) in the LiDAR frame."""
+    out = []
+    if not os.path.exists(path):
+        return out
+    for line in open(path):
+        f = line.split()
+        if len(f) < 16:
+            continue
+        h, w, l = float(f[8]), float(f[9]), float(f[10])
+        c = cam_to_velo @ np.array([float(f[11]), float(f[12]), float(f[13]), 1.0])
+        yaw = -float(f[14]) - math.pi / 2
+        out.append((f[0], float(f[15]), c[0], c[1], c[2], l, w, h, yaw))
+    return out
+
+
+def local_frame(pts, x, y, yaw):
+    c, s = math.cos(yaw), math.sin(yaw)
+    dx, dy = pts[:, 0] - x, pts[:, 1] - y
+    return c * dx + s * dy, -s * dx + c * dy
+
+
+def embedded_in_structure(pts, b):
+    """True when a small-object box stands in a wall, hedge or under a tree rather than in free space."""
+    cls, score, x, y, zb, l, w, h, yaw = b
+    near = pts[(np.abs(pts[:, 0] - x) < 4) & (np.abs(pts[:, 1] - y) < 4)]
+    if len(near) == 0:
+        return False
+    u, v = local_frame(near, x, y, yaw)
+    ground = np.percentile(near[:, 2], 5)
+    above = near[:, 2] - ground
+    inside = (np.abs(u) <= l / 2) & (np.abs(v) <= w / 2)
+    body = inside & (above > 0.3) & (above < 2.2)
+    tall = inside & (above > 2.6)
+    # The band 0.3-1.0 m beyond the box's sides: free space around a person or a cyclist, a wall or hedge beside a
+    # box cut out of it.
+    band = (np.abs(u) <= l / 2 + 1.0) & (np.abs(v) <= w / 2 + 1.0) & ~((np.abs(u) <= l / 2 + 0.3) & (np.abs(v) <= w / 2 + 0.3))
+    band &= (above > 0.3) & (above < 2.2)
+    n_body, n_tall, n_band = int(body.sum()), int(tall.sum()), int(band.sum())
+    # Fewer than five returns: nothing to see at the place (behind a wall, in a gap of the scan).
+    return n_body < 5 or n_tall >= 5 or n_band > max(8, 1.5 * n_body)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("root")
+    ap.add_argument("pred")
+    ap.add_argument("--grow", type=float, default=0.3)
+    ap.add_argument("--min-score", type=float, default=0.1,
+                    help="boxes scored lower are background too (the detector already calls them so)")
+    ap.add_argument("--debug-out", help="also write the boxes left as background here (KITTI result files)")
+    a = ap.parse_args()
+    tr = os.path.join(a.root, "training") if os.path.isdir(os.path.join(a.root, "training")) else a.root
+    scans = sorted(glob.glob(os.path.join(tr, "velodyne", "*.bin")))
+    if not scans:
+        sys.exit("real_negatives.py: no scans in %s/velodyne" % tr)
+    os.makedirs(os.path.join(tr, "label_2"), exist_ok=True)
+    counts = {}
+    for scan in scans:
+        frame = os.path.splitext(os.path.basename(scan))[0]
+        cam_to_velo = read_calib(os.path.join(tr, "calib", frame + ".txt"))
+        velo_to_cam = np.linalg.inv(cam_to_velo)
+        pts = np.fromfile(scan, dtype=np.float32).reshape(-1, 4)[:, :3].astype(np.float64)
+        lines = []
+        pred_file = os.path.join(a.pred, frame + ".txt")
+        raw = open(pred_file).readlines() if os.path.exists(pred_file) else []
+        frame_boxes = read_boxes(pred_file, cam_to_velo)
+        for b in frame_boxes:
+            cls = b[0]
+            background = b[1] < a.min_score or (cls in ("Pedestrian", "Cyclist") and embedded_in_structure(pts, b))
+            key = (cls, "background" if background else "DontCare")
+            counts[key] = counts.get(key, 0) + 1
+            if background:
+                if a.debug_out:
+                    os.makedirs(a.debug_out, exist_ok=True)
+                    with open(os.path.join(a.debug_out, frame + ".txt"), "a") as f:
+                        f.write(raw[frame_boxes.index(b)])
+                continue
+            _, _, x, y, zb, l, w, h, yaw = b
+            c = velo_to_cam @ np.array([x, y, zb, 1.0])
+            ry = -yaw - math.pi / 2
+            lines.append("DontCare 0.00 0 -10 0 0 0 0 %.3f %.3f %.3f %.3f %.3f %.3f %.4f\n" %
+                         (h + 0.2, w + 2 * a.grow, l + 2 * a.grow, c[0], c[1], c[2], ry))
+        with open(os.path.join(tr, "label_2", frame + ".txt"), "w") as f:
+            f.writelines(lines)
+    for k in sorted(counts):
+        print("%-10s %-10s %6d" % (k[0], k[1], counts[k]))
+    print("%d scans" % len(scans))
+
+
+if __name__ == "__main__":
+    main()
