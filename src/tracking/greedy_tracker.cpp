@@ -139,7 +139,7 @@ std::vector<std::size_t> GreedyTracker::step(const std::vector<Box>& detections,
         track = &tracks_[det_to_track[k]];
         track_matched[det_to_track[k]] = 1;
       } else {
-        if (c.fixed.score < options_.birth_score) continue;
+        if (c.fixed.score < options_.birth_score.at(label)) continue;
         born.emplace_back(static_cast<std::size_t>(options_.history_length));
         track = &born.back();
         track->id = next_id_++;

@@ -76,7 +76,12 @@ TrackerOptions fromNode(const YAML::Node& root) {
     } else if (key == "score_threshold") {
       o.score_threshold = readDouble(v, key);
     } else if (key == "birth_score") {
-      o.birth_score = readDouble(v, key);
+      if (v.IsScalar()) {
+        const double b = readDouble(v, key);
+        o.birth_score = {b, b, b};
+      } else {
+        readPerClass(v, key, o.birth_score);
+      }
     } else if (key == "max_age") {
       o.max_age = readInt(v, key);
     } else if (key == "max_time_gap") {
@@ -108,9 +113,10 @@ void validate(const TrackerOptions& o) {
     if (!std::isfinite(g) || g <= 0.0) invalid("gate." + cls, str(g), "a finite distance > 0 (m)");
     const double s = o.max_speed.at(c);
     if (!std::isfinite(s) || s < 0.0) invalid("max_speed." + cls, str(s), "a finite speed >= 0 (m/s)");
+    const double b = o.birth_score.at(c);
+    if (!std::isfinite(b)) invalid("birth_score." + cls, str(b), "a finite number");
   }
   if (!std::isfinite(o.score_threshold)) invalid("score_threshold", str(o.score_threshold), "a finite number");
-  if (!std::isfinite(o.birth_score)) invalid("birth_score", str(o.birth_score), "a finite number");
   if (o.max_age < 0 || o.max_age > 1000) invalid("max_age", str(o.max_age), "an integer in [0, 1000] (frames)");
   if (!std::isfinite(o.max_time_gap) || o.max_time_gap <= 0.0)
     invalid("max_time_gap", str(o.max_time_gap), "a finite time > 0 (s)");

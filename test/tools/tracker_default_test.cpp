@@ -29,7 +29,7 @@ TEST(TrackerDefault, TheBaseStageTracksWithTheNodeletsConfig) {
   EXPECT_NE(params.find("tracker_config: $(find ret3d)/" + std::string(kPipelineTrackerConfig)), std::string::npos);
   // And it differs from the built-in values where it matters here: it keeps low probabilities.
   const TrackerOptions pipeline = loadTrackerOptions(expected), built_in;
-  EXPECT_LT(pipeline.birth_score, built_in.birth_score);
+  EXPECT_LT(pipeline.birth_score.car, built_in.birth_score.car);
 }
 
 TEST(TrackerDefault, ExternalDetectionsKeepTheBuiltInValues) {

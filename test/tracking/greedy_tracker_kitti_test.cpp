@@ -182,8 +182,8 @@ TEST(GreedyTrackerKitti, AblationOverTrainingSequences) {
   with("hungarian", [](TrackerOptions& o) { o.assignment = AssignmentMethod::Hungarian; });
   with("velocity_window 3", [](TrackerOptions& o) { o.velocity_window = 3; });
   with("velocity_window 10", [](TrackerOptions& o) { o.velocity_window = 10; });
-  with("birth_score 0.5", [](TrackerOptions& o) { o.birth_score = 0.5; });
-  with("birth_score 0.9", [](TrackerOptions& o) { o.birth_score = 0.9; });
+  with("birth_score 0.5", [](TrackerOptions& o) { o.birth_score = {0.5, 0.5, 0.5}; });
+  with("birth_score 0.9", [](TrackerOptions& o) { o.birth_score = {0.9, 0.9, 0.9}; });
   with("max_speed 0 (no unknown-velocity slack)", [](TrackerOptions& o) { o.max_speed = {0, 0, 0}; });
   std::printf("[ kitti    ] %-42s | per class: ID switches (per 100 truth tracks), ids paired with truth, all ids, "
               "truth boxes paired\n", "0001-0015 ablation");

@@ -333,7 +333,7 @@ TEST(GreedyTracker, IdsAreNeverReused) {
 TEST(GreedyTracker, BirthScoreAndScoreThreshold) {
   TrackerOptions o;
   o.score_threshold = 0.2;
-  o.birth_score = 0.5;
+  o.birth_score = {0.5, 0.5, 0.5};
   GreedyTracker tracker(o);
   Box a = Actor{ObjectClass::Car, 10, 0, 10, 0}.at(0);
   a.score = 0.4f;  // too low to start a track

@@ -23,9 +23,9 @@ void expectSame(const TrackerOptions& a, const TrackerOptions& b) {
   for (ObjectClass c : kDetectedClasses) {
     EXPECT_DOUBLE_EQ(a.gate.at(c), b.gate.at(c)) << className(c);
     EXPECT_DOUBLE_EQ(a.max_speed.at(c), b.max_speed.at(c)) << className(c);
+    EXPECT_DOUBLE_EQ(a.birth_score.at(c), b.birth_score.at(c)) << className(c);
   }
   EXPECT_DOUBLE_EQ(a.score_threshold, b.score_threshold);
-  EXPECT_DOUBLE_EQ(a.birth_score, b.birth_score);
   EXPECT_EQ(a.max_age, b.max_age);
   EXPECT_DOUBLE_EQ(a.max_time_gap, b.max_time_gap);
   EXPECT_EQ(a.use_detection_velocity, b.use_detection_velocity);
@@ -56,7 +56,12 @@ TEST(TrackerOptions, ReadsEveryKey) {
   EXPECT_DOUBLE_EQ(o.gate.cyclist, 0.9);
   EXPECT_DOUBLE_EQ(o.max_speed.pedestrian, 4.0);
   EXPECT_DOUBLE_EQ(o.score_threshold, -1.0);
-  EXPECT_DOUBLE_EQ(o.birth_score, 2.0);
+  for (ObjectClass c : kDetectedClasses) EXPECT_DOUBLE_EQ(o.birth_score.at(c), 2.0) << className(c);  // one for all
+  // Or per class, absent classes keeping the default.
+  const TrackerOptions per_class = parseTrackerOptions("birth_score: {Car: 0.3, Cyclist: 0.6}\n");
+  EXPECT_DOUBLE_EQ(per_class.birth_score.car, 0.3);
+  EXPECT_DOUBLE_EQ(per_class.birth_score.pedestrian, TrackerOptions().birth_score.pedestrian);
+  EXPECT_DOUBLE_EQ(per_class.birth_score.cyclist, 0.6);
   EXPECT_EQ(o.max_age, 5);
   EXPECT_DOUBLE_EQ(o.max_time_gap, 0.5);
   EXPECT_FALSE(o.use_detection_velocity);
@@ -80,7 +85,9 @@ TEST(TrackerOptions, InvalidValuesNameParameterValueAndAllowed) {
       {"gate: 1.0", "gate", "1.0", "a map"},
       {"max_speed: {Cyclist: -3}", "max_speed.Cyclist", "-3", ">= 0"},
       {"score_threshold: abc", "score_threshold", "abc", "a number"},
-      {"birth_score: .nan", "birth_score", "nan", "finite"},
+      {"birth_score: .nan", "birth_score.Car", "nan", "finite"},  // one value for all classes
+      {"birth_score: {Cyclist: .nan}", "birth_score.Cyclist", "nan", "finite"},
+      {"birth_score: {Truck: 0.5}", "birth_score.Truck", "0.5", "class keys"},
       {"max_age: -1", "max_age", "-1", "[0, 1000]"},
       {"max_age: 2.5", "max_age", "2.5", "an integer"},
       {"max_time_gap: 0", "max_time_gap", "0", "> 0"},

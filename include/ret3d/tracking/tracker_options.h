@@ -49,7 +49,9 @@ struct TrackerOptions {
   // An unmatched detection starts a new track only if its score is at least this: CenterPoint's Waymo score_thresh.
   // Lower values start a track for every clutter box (KITTI 0001-0015: 0.5 gives 1.8x the ids of 0.75 and more
   // ID switches); higher ones lose the first frames of real objects. A score is a probability (sigmoid of a logit).
-  double birth_score = 0.75;
+  // Per class (YAML: one number for all, or a map by class): a class whose scores are less calibrated (the LWD-3D
+  // detector's cyclists) needs a stricter birth than the others.
+  PerClass<double> birth_score{0.75, 0.75, 0.75};
   // Frames a track may go unmatched and still be matched again; it coasts on its velocity meanwhile and is not output.
   // CenterPoint's Waymo max_age = 3 counts the matched frame too (2 coasting frames; ours counts misses only). On the
   // PointRCNN boxes of KITTI tracking 0001-0015 car ID switches went 179 / 122 / 105 / 99 for 1 / 3 / 5 / 10: 5
