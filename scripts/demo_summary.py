@@ -94,7 +94,7 @@ def main():
             if d is None:
                 continue
             f_in, f_out = number(d, "frames in"), number(d, "frames out")
-            dropped = number(d, "frames dropped (latest-frame policy)")
+            dropped = number(d, "frames dropped")
             p50, p95 = number(d, "processing p50 (ms)"), number(d, "processing p95 (ms)")
             l50, l95 = number(d, "latency since cloud stamp p50 (ms)"), number(d, "latency since cloud stamp p95 (ms)")
             print(f"  {stage:<18} {f_in:>10.0f} {f_out:>4.0f} {dropped:>8.0f}"
