@@ -94,12 +94,19 @@ def main():
             if d is None:
                 continue
             f_in, f_out = number(d, "frames in"), number(d, "frames out")
-            dropped = number(d, "frames dropped (latest-frame policy)")
+            dropped = number(d, "frames dropped")
             p50, p95 = number(d, "processing p50 (ms)"), number(d, "processing p95 (ms)")
             l50, l95 = number(d, "latency since cloud stamp p50 (ms)"), number(d, "latency since cloud stamp p95 (ms)")
             print(f"  {stage:<18} {f_in:>10.0f} {f_out:>4.0f} {dropped:>8.0f}"
                   f"  {p50:>12.1f} / {p95:<9.1f}  {l50:>10.1f} / {l95:.1f}")
         print("  (the stages' last /diagnostics report; latency from the cloud's stamp, in the bag's time)")
+        # Why frames were dropped or what was worked around (README "Diagnostics"), where anything was.
+        for stage in STAGES:
+            d = diagnostics.get(stage, {})
+            counted = [f"{key} {number(d, key):.0f}" for key in d
+                       if key.startswith(("dropped.", "degraded.")) and (number(d, key) or 0) > 0]
+            if counted:
+                print(f"  {stage:<18} {', '.join(counted)}")
     else:
         print("  (no /diagnostics recorded: no per-stage figures)")
 

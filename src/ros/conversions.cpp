@@ -210,15 +210,25 @@ PointCloud toCloud(const sensor_msgs::PointCloud2& msg, const CloudConversionOpt
   if (fring) rep.has_ring = true;
   if (ftime) rep.time_field = ftime->name;
 
-  cloud.points.reserve(n);
+  // Over the limit: input point k (row-major index) is read when floor(k * kept / n) steps up, which happens for
+  // exactly `kept` of the n indices, spread evenly (128-bit products: k * kept may pass 2^64 for huge messages).
+  const std::size_t kept = options.max_points > 0 && n > options.max_points ? options.max_points : n;
+  rep.thinned = kept < n;
+  const auto read = [&](std::size_t k) {
+    return kept == n ||
+           (static_cast<unsigned __int128>(k) * kept) / n != (static_cast<unsigned __int128>(k + 1) * kept) / n;
+  };
+
+  cloud.points.reserve(kept);
   std::vector<double> times;
-  if (ftime) times.reserve(n);
-  if (fring) cloud.ring.reserve(n);
+  if (ftime) times.reserve(kept);
+  if (fring) cloud.ring.reserve(kept);
 
   double raw_max = 0.0;
   for (std::size_t row = 0; row < height; ++row) {
     const std::uint8_t* row_ptr = msg.data.data() + row * msg.row_step;
     for (std::size_t col = 0; col < width; ++col) {
+      if (!read(row * width + col)) continue;
       const std::uint8_t* p = row_ptr + col * msg.point_step;
       const double x = fx->read(p), y = fy->read(p), z = fz->read(p);
       if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) {

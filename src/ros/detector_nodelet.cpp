@@ -1,9 +1,12 @@
 // ret3d/DetectorNodelet: points (PointCloud2 of any layout) -> LWD-3D Detector -> detections (DetectionArray with the
 // per-object features). The previous sweep is kept for LWD-3D's two-sweep input; its motion to the current sweep
-// comes from tf2 (both sensor poses in the fixed frame). What the nodelet works around, it says (throttled): a cloud
-// without intensity or with NaN points (from the conversion report), an empty or malformed cloud (empty detections
-// published), a missing transform (previous sweep used without motion compensation), stamps going backwards or a gap
-// longer than ~max_sweep_gap (previous sweep dropped).
+// comes from tf2 (both sensor poses in the fixed frame). Every cloud is answered with a DetectionArray unless the
+// latest-frame policy or ~max_input_age drops it (StageNodelet). What the nodelet works around, it says (throttled)
+// and counts on /diagnostics as degraded.<kind>: a cloud without intensity (conversion) or with NaN points
+// (nonfinite_points), more points than ~max_points (over_point_limit: thinned evenly, not dropped), an empty
+// (empty) or malformed (malformed) cloud (empty detections published), a missing transform (no_transform: previous
+// sweep used without motion compensation), stamps going backwards (stamp_backwards), a gap longer than
+// ~max_sweep_gap (sweep_gap) or a changed frame id (frame_changed): previous sweep not used.
 #include <chrono>
 #include <cmath>
 #include <mutex>
@@ -88,10 +91,17 @@ class DetectorNodelet : public StageNodelet<sensor_msgs::PointCloud2> {
       publisher_.publish(toDetectionArrayMsg(empty, msg->header));
       return;
     }
-    for (const std::string& w : report.warnings) degraded("conversion: " + w.substr(0, 20), "cloud: " + w);
+    for (const std::string& w : report.warnings) {
+      degraded("conversion", "cloud: " + w, "conversion: " + w.substr(0, 20));
+    }
+    if (report.thinned) {
+      degraded("over_point_limit", "cloud of " + std::to_string(report.input_points) + " points (> ~max_points " +
+                                       std::to_string(params_.cloud.max_points) + "): thinned evenly, " +
+                                       std::to_string(report.output_points) + " points kept");
+    }
     if (report.dropped_nonfinite > 0) {
-      degraded("nonfinite", "dropped " + std::to_string(report.dropped_nonfinite) + " of " +
-                                std::to_string(report.input_points) + " points with a NaN or Inf coordinate");
+      degraded("nonfinite_points", "dropped " + std::to_string(report.dropped_nonfinite) + " of " +
+                                       std::to_string(report.input_points) + " points with a NaN or Inf coordinate");
     }
     if (cloud.empty()) {
       degraded("empty", "empty cloud (after dropping invalid points): no detections");
@@ -105,20 +115,20 @@ class DetectorNodelet : public StageNodelet<sensor_msgs::PointCloud2> {
     if (previous_) {
       const double gap = stamp - previous_->stamp;
       if (gap <= 0.0) {
-        degraded("backwards", "stamp went backwards or repeated (" + std::to_string(previous_->stamp) + " -> " +
-                                  std::to_string(stamp) + "): previous sweep dropped");
+        degraded("stamp_backwards", "stamp went backwards or repeated (" + std::to_string(previous_->stamp) + " -> " +
+                                        std::to_string(stamp) + "): previous sweep dropped");
       } else if (gap > params_.max_sweep_gap) {
-        degraded("gap", "previous sweep " + std::to_string(gap) + " s old (> ~max_sweep_gap): not used");
+        degraded("sweep_gap", "previous sweep " + std::to_string(gap) + " s old (> ~max_sweep_gap): not used");
       } else if (previous_->frame_id != msg->header.frame_id) {
-        degraded("frame", "frame id changed from " + previous_->frame_id + ": previous sweep dropped");
+        degraded("frame_changed", "frame id changed from " + previous_->frame_id + ": previous sweep dropped");
       } else {
         previous = &previous_->cloud;
         if (pose.found && previous_->pose_found) {
           prev_to_current = pose.sensor_to_fixed.inverse() * previous_->sensor_to_fixed;
         } else {
-          degraded("tf", "no transform " + msg->header.frame_id + " -> " + poses_->fixedFrame() + " at " +
-                             std::to_string(stamp) + " (" + (pose.found ? "previous sweep" : pose.problem) +
-                             "): previous sweep used without motion compensation");
+          degraded("no_transform", "no transform " + msg->header.frame_id + " -> " + poses_->fixedFrame() + " at " +
+                                       std::to_string(stamp) + " (" + (pose.found ? "previous sweep" : pose.problem) +
+                                       "): previous sweep used without motion compensation");
         }
       }
     }

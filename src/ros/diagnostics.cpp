@@ -17,6 +17,24 @@ double percentile(std::vector<double> values, double p) {
   return values[lo] + (pos - static_cast<double>(lo)) * (values[hi] - values[lo]);
 }
 
+const char* dropReasonName(DropReason reason) {
+  switch (reason) {
+    case DropReason::Superseded:
+      return "superseded";
+    case DropReason::TooOld:
+      return "too_old";
+    case DropReason::Error:
+      return "error";
+  }
+  return "unknown";
+}
+
+std::size_t StageMonitor::Snapshot::dropped() const {
+  std::size_t sum = 0;
+  for (const std::size_t n : dropped_by_reason) sum += n;
+  return sum;
+}
+
 void StageMonitor::input() {
   const double now = ros::WallTime::now().toSec();
   std::lock_guard<std::mutex> lock(mutex_);
@@ -25,9 +43,9 @@ void StageMonitor::input() {
   while (!arrivals_.empty() && arrivals_.front() < now - 10.0) arrivals_.pop_front();
 }
 
-void StageMonitor::dropped() {
+void StageMonitor::dropped(DropReason reason) {
   std::lock_guard<std::mutex> lock(mutex_);
-  ++dropped_;
+  ++dropped_[static_cast<std::size_t>(reason)];
 }
 
 void StageMonitor::processed(double processing_ms, const ros::Time& input_stamp) {
@@ -40,9 +58,10 @@ void StageMonitor::processed(double processing_ms, const ros::Time& input_stamp)
   while (latency_ms_.size() > window_) latency_ms_.pop_front();
 }
 
-void StageMonitor::degraded(const std::string& what) {
+void StageMonitor::degraded(const std::string& kind, const std::string& what) {
   std::lock_guard<std::mutex> lock(mutex_);
   ++degraded_;
+  ++degraded_by_kind_[kind];
   last_degradation_ = what;
 }
 
@@ -51,8 +70,9 @@ StageMonitor::Snapshot StageMonitor::snapshot() const {
   Snapshot s;
   s.inputs = inputs_;
   s.processed = processed_;
-  s.dropped = dropped_;
+  s.dropped_by_reason = dropped_;
   s.degraded = degraded_;
+  s.degraded_by_kind = degraded_by_kind_;
   if (arrivals_.size() >= 2) {
     const double span = arrivals_.back() - arrivals_.front();
     if (span > 0) s.input_rate_hz = static_cast<double>(arrivals_.size() - 1) / span;
@@ -73,10 +93,10 @@ void StageMonitor::fill(diagnostic_updater::DiagnosticStatusWrapper& status) {
   std::size_t new_drops = 0, new_degraded = 0;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    new_drops = dropped_ - reported_dropped_;
-    new_degraded = degraded_ - reported_degraded_;
-    reported_dropped_ = dropped_;
-    reported_degraded_ = degraded_;
+    new_drops = s.dropped() - reported_dropped_;
+    new_degraded = s.degraded - reported_degraded_;
+    reported_dropped_ = s.dropped();
+    reported_degraded_ = s.degraded;
   }
   if (new_drops > 0 || new_degraded > 0) {
     status.summaryf(diagnostic_msgs::DiagnosticStatus::WARN, "%zu frames dropped, %zu degraded since last report%s%s",
@@ -87,8 +107,12 @@ void StageMonitor::fill(diagnostic_updater::DiagnosticStatusWrapper& status) {
   status.add("input rate (Hz)", s.input_rate_hz);
   status.add("frames in", s.inputs);
   status.add("frames out", s.processed);
-  status.add("frames dropped (latest-frame policy)", s.dropped);
+  status.add("frames dropped", s.dropped());
+  for (std::size_t r = 0; r < kNumDropReasons; ++r) {
+    status.add(std::string("dropped.") + dropReasonName(static_cast<DropReason>(r)), s.dropped_by_reason[r]);
+  }
   status.add("frames degraded", s.degraded);
+  for (const auto& [kind, n] : s.degraded_by_kind) status.add("degraded." + kind, n);
   status.add("processing p50 (ms)", s.processing_p50_ms);
   status.add("processing p95 (ms)", s.processing_p95_ms);
   status.add("processing max (ms)", s.processing_max_ms);

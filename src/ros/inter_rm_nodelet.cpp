@@ -47,8 +47,9 @@ class InterRMNodelet : public StageNodelet<ret3d::DetectionArray> {
     }
     const double stamp = msg->header.stamp.toSec();
     if (has_stamp_ && stamp < last_stamp_) {
-      degraded("backwards", "stamp went backwards (" + std::to_string(last_stamp_) + " -> " + std::to_string(stamp) +
-                                "): " + std::to_string(histories_.size()) + " track histories cleared");
+      degraded("stamp_backwards", "stamp went backwards (" + std::to_string(last_stamp_) + " -> " +
+                                      std::to_string(stamp) + "): " + std::to_string(histories_.size()) +
+                                      " track histories cleared");
       histories_.clear();
     }
     has_stamp_ = true;
@@ -57,8 +58,8 @@ class InterRMNodelet : public StageNodelet<ret3d::DetectionArray> {
 
     const PoseSource::Result pose = poses_->lookup(msg->header.frame_id, msg->header.stamp);
     if (!pose.found) {
-      degraded("tf", "no transform " + msg->header.frame_id + " -> " + poses_->fixedFrame() + " (" + pose.problem +
-                         "): histories kept with the last pose found");
+      degraded("no_transform", "no transform " + msg->header.frame_id + " -> " + poses_->fixedFrame() + " (" +
+                                   pose.problem + "): histories kept with the last pose found");
     }
 
     std::vector<Box> boxes = fromMsgs(*msg);
@@ -100,7 +101,7 @@ class InterRMNodelet : public StageNodelet<ret3d::DetectionArray> {
         const std::vector<Box> refined = inter_->refine(sequences);
         for (std::size_t s = 0; s < refined.size(); ++s) boxes[sequence_box[s]] = refined[s];
       } catch (const std::exception& e) {
-        degraded("refine", std::string("InterRM skipped, tracked boxes passed through unrefined: ") + e.what());
+        degraded("refine_failed", std::string("InterRM skipped, tracked boxes passed through unrefined: ") + e.what());
       }
     }
     ret3d::Object3DArrayPtr out(new ret3d::Object3DArray(toMsg(boxes, msg->header)));

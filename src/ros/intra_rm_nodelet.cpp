@@ -28,7 +28,7 @@ class IntraRMNodelet : public StageNodelet<ret3d::DetectionArray> {
     try {
       out = intra_->refine(in);
     } catch (const std::exception& e) {
-      degraded("refine", std::string("IntraRM skipped, detections passed through unrefined: ") + e.what());
+      degraded("refine_failed", std::string("IntraRM skipped, detections passed through unrefined: ") + e.what());
       out = in;
     }
     publisher_.publish(toDetectionArrayMsg(out, msg->header));

@@ -25,8 +25,8 @@ class MarkerNodelet : public StageNodelet<ret3d::Object3DArray> {
   void process(const ret3d::Object3DArray::ConstPtr& msg) override {
     const PoseSource::Result pose = poses_->lookup(msg->header.frame_id, msg->header.stamp);
     if (!pose.found) {
-      degraded("tf", "no transform " + msg->header.frame_id + " -> " + poses_->fixedFrame() + " (" + pose.problem +
-                         "): trails drawn without ego motion");
+      degraded("no_transform", "no transform " + msg->header.frame_id + " -> " + poses_->fixedFrame() + " (" +
+                                   pose.problem + "): trails drawn without ego motion");
     }
     visualization_msgs::MarkerArrayPtr out(new visualization_msgs::MarkerArray(
         builder_.build(fromMsg(*msg), msg->header, pose.sensor_to_fixed)));

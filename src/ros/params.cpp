@@ -157,6 +157,13 @@ std::string packagePath() { return ros::package::getPath("ret3d"); }
 
 std::string defaultModelPath(const std::string& file_name) { return packagePath() + "/models/lwd3d/" + file_name; }
 
+StageParams loadStageParams(const ros::NodeHandle& private_nh) {
+  const ParamReader p(private_nh);
+  StageParams params;
+  params.max_input_age = p.number("max_input_age", params.max_input_age, 0.0, 3600.0);
+  return params;
+}
+
 DetectorNodeletParams loadDetectorNodeletParams(const ros::NodeHandle& private_nh) {
   const ParamReader p(private_nh);
   DetectorNodeletParams params;
@@ -196,6 +203,9 @@ DetectorNodeletParams loadDetectorNodeletParams(const ros::NodeHandle& private_n
                                    : scaling == "observed_max" ? IntensityScaling::ObservedMax
                                                                : IntensityScaling::FixedScale;
   params.cloud.intensity_scale = p.number("intensity_scale", params.cloud.intensity_scale, 1e-6, 1e9);
+  // 500,000: twice a 128-beam scan, four times an HDL-64E's. Below a thousand points a scan is no longer a scan;
+  // above 10 million one cloud takes seconds to convert alone.
+  params.cloud.max_points = static_cast<std::size_t>(p.integer("max_points", 500000, 1000, 10000000));
   params.pose = loadPoseParams(p);
   params.max_sweep_gap = p.number("max_sweep_gap", params.max_sweep_gap, 0.0, 10.0);
   return params;

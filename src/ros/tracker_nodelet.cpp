@@ -27,16 +27,17 @@ class TrackerNodelet : public StageNodelet<ret3d::DetectionArray> {
   void process(const ret3d::DetectionArray::ConstPtr& msg) override {
     const PoseSource::Result pose = poses_->lookup(msg->header.frame_id, msg->header.stamp);
     if (!pose.found) {
-      degraded("tf", "no transform " + msg->header.frame_id + " -> " + poses_->fixedFrame() + " at " +
-                         std::to_string(msg->header.stamp.toSec()) + " (" + pose.problem + "): tracking with " +
-                         (poses_->hasFallbackPose(msg->header.frame_id) ? "the last pose found"
-                                                                        : "the sensor frame as fixed frame"));
+      degraded("no_transform", "no transform " + msg->header.frame_id + " -> " + poses_->fixedFrame() + " at " +
+                                   std::to_string(msg->header.stamp.toSec()) + " (" + pose.problem +
+                                   "): tracking with " +
+                                   (poses_->hasFallbackPose(msg->header.frame_id) ? "the last pose found"
+                                                                                  : "the sensor frame as fixed frame"));
     }
     const std::size_t resets = tracker_->numResets();
     const Detections tracked = tracker_->update(toDetections(*msg), msg->header.stamp.toSec(), pose.sensor_to_fixed);
     if (tracker_->numResets() != resets) {
-      degraded("reset", "stamp went backwards or jumped at " + std::to_string(msg->header.stamp.toSec()) +
-                            ": tracker reset (track ids keep counting)");
+      degraded("tracker_reset", "stamp went backwards or jumped at " + std::to_string(msg->header.stamp.toSec()) +
+                                    ": tracker reset (track ids keep counting)");
     }
     publisher_.publish(toDetectionArrayMsg(tracked, msg->header));
   }

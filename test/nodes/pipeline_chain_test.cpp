@@ -31,28 +31,6 @@ namespace {
 
 constexpr int kFrames = 8;
 
-// What a subscriber saw, by arrival.
-template <typename M>
-struct Inbox {
-  std::mutex mutex;
-  std::vector<typename M::ConstPtr> messages;
-  ros::Subscriber sub;
-  void listen(ros::NodeHandle& nh, const std::string& topic) {
-    sub = nh.subscribe<M>(topic, 100, [this](const typename M::ConstPtr& m) {
-      std::lock_guard<std::mutex> lock(mutex);
-      messages.push_back(m);
-    });
-  }
-  std::size_t size() {
-    std::lock_guard<std::mutex> lock(mutex);
-    return messages.size();
-  }
-  std::vector<typename M::ConstPtr> all() {
-    std::lock_guard<std::mutex> lock(mutex);
-    return messages;
-  }
-};
-
 // One bag frame: its tf messages and its ground truth.
 struct BagFrames {
   std::vector<tf2_msgs::TFMessage::ConstPtr> tf_static;
@@ -164,9 +142,9 @@ class PipelineChain : public ::testing::Test {
   test::LogCapture log_;
   ros::NodeHandle nh_;
   ros::Publisher detections_pub_, tf_pub_, tf_static_pub_;
-  Inbox<ret3d::DetectionArray> intra_, tracked_;
-  Inbox<ret3d::Object3DArray> objects_;
-  Inbox<visualization_msgs::MarkerArray> markers_;
+  test::Inbox<ret3d::DetectionArray> intra_, tracked_;
+  test::Inbox<ret3d::Object3DArray> objects_;
+  test::Inbox<visualization_msgs::MarkerArray> markers_;
 };
 
 TEST_F(PipelineChain, EveryFrameThroughEveryStageWithStableIds) {

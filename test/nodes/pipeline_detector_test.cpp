@@ -48,63 +48,6 @@ std::string smallConfig(const std::string& source_dir) {
   return text;
 }
 
-sensor_msgs::PointField field(const std::string& name, std::uint32_t offset, std::uint8_t type) {
-  sensor_msgs::PointField f;
-  f.name = name;
-  f.offset = offset;
-  f.datatype = type;
-  f.count = 1;
-  return f;
-}
-
-// An Ouster OS1-64 driver cloud (the first 64 * W points of `cloud`): organized 64 x W, point_step 48 with padding, x y z float32, intensity float32 in
-// the thousands, t uint32 ns, reflectivity uint16, ring uint8.
-sensor_msgs::PointCloud2 ousterCloud(const PointCloud& cloud, const std_msgs::Header& header) {
-  sensor_msgs::PointCloud2 msg;
-  msg.header = header;
-  msg.height = 64;
-  msg.width = static_cast<std::uint32_t>(cloud.size() / 64);
-  msg.fields = {field("x", 0, sensor_msgs::PointField::FLOAT32), field("y", 4, sensor_msgs::PointField::FLOAT32),
-                field("z", 8, sensor_msgs::PointField::FLOAT32),
-                field("intensity", 16, sensor_msgs::PointField::FLOAT32),
-                field("t", 20, sensor_msgs::PointField::UINT32),
-                field("reflectivity", 24, sensor_msgs::PointField::UINT16),
-                field("ring", 26, sensor_msgs::PointField::UINT8)};
-  msg.point_step = 48;
-  msg.row_step = msg.point_step * msg.width;
-  msg.is_dense = false;
-  msg.data.assign(static_cast<std::size_t>(msg.row_step) * msg.height, 0);
-  for (std::size_t i = 0; i < static_cast<std::size_t>(msg.width) * msg.height; ++i) {
-    std::uint8_t* p = msg.data.data() + i * msg.point_step;
-    const Point q = cloud.points[i];
-    const float intensity = q.intensity * 3000.0f;
-    const std::uint32_t t = static_cast<std::uint32_t>(i % 1024) * 97000u;
-    std::memcpy(p + 0, &q.x, 4);
-    std::memcpy(p + 4, &q.y, 4);
-    std::memcpy(p + 8, &q.z, 4);
-    std::memcpy(p + 16, &intensity, 4);
-    std::memcpy(p + 20, &t, 4);
-    p[26] = static_cast<std::uint8_t>(i / msg.width);
-  }
-  return msg;
-}
-
-// x, y, z float32 only.
-sensor_msgs::PointCloud2 xyzCloud(const PointCloud& cloud, const std_msgs::Header& header) {
-  sensor_msgs::PointCloud2 msg;
-  msg.header = header;
-  msg.height = 1;
-  msg.width = static_cast<std::uint32_t>(cloud.size());
-  msg.fields = {field("x", 0, sensor_msgs::PointField::FLOAT32), field("y", 4, sensor_msgs::PointField::FLOAT32),
-                field("z", 8, sensor_msgs::PointField::FLOAT32)};
-  msg.point_step = 12;
-  msg.row_step = 12 * msg.width;
-  msg.is_dense = true;
-  msg.data.resize(msg.row_step);
-  for (std::size_t i = 0; i < cloud.size(); ++i) std::memcpy(msg.data.data() + 12 * i, &cloud.points[i], 12);
-  return msg;
-}
-
 class DetectorNodeletTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -197,11 +140,11 @@ TEST_F(DetectorNodeletTest, EveryCloudGivesDetectionsAndWhatWasDoneIsSaid) {
   h.stamp = ros::Time(t += 0.1);
   publishTf(h.stamp.toSec(), 2.0);
   ros::WallDuration(0.05).sleep();
-  send(ousterCloud(seq_.scans[2], h), "Ouster");
+  send(test::ousterCloud(seq_.scans[2], h), "Ouster");
   // No intensity.
   h.stamp = ros::Time(t += 0.1);
   publishTf(h.stamp.toSec(), 3.0);
-  send(xyzCloud(seq_.scans[0], h), "no-intensity");
+  send(test::xyzCloud(seq_.scans[0], h), "no-intensity");
   EXPECT_FALSE(log_.find({"no intensity field"}).empty()) << log_.all();
   // Empty.
   h.stamp = ros::Time(t += 0.1);
@@ -218,16 +161,9 @@ TEST_F(DetectorNodeletTest, EveryCloudGivesDetectionsAndWhatWasDoneIsSaid) {
   send(toPointCloud2(nan_cloud, h), "NaN");
   EXPECT_FALSE(log_.find({"dropped 1000 of 1000 points", "NaN"}).empty()) << log_.all();
   // A million points.
-  PointCloud big;
-  big.points.reserve(1000000);
-  for (int i = 0; i < 1000000; ++i) {
-    const double a = i * 0.000628, r = 3.0 + (i % 2000) * 0.01;
-    big.points.push_back({static_cast<float>(r * std::cos(a)), static_cast<float>(r * std::sin(a)),
-                          static_cast<float>(-1.7 + 0.001 * (i % 3000)), 0.3f});
-  }
   h.stamp = ros::Time(t += 0.1);
   publishTf(h.stamp.toSec(), 6.0);
-  send(toPointCloud2(big, h), "1-million-point");
+  send(toPointCloud2(test::millionPointCloud(), h), "1-million-point");
   // Stamps going backwards.
   h.stamp = ros::Time(t - 0.35);
   publishTf(h.stamp.toSec(), 2.5);
@@ -330,6 +266,17 @@ TEST_F(DetectorNodeletTest, TheGridExtentWidensTheGroundCoveredAndAWrongOneIsRef
     EXPECT_FALSE(log_.find({"refuses to start", "/bad_detector/grid_extent"}).empty()) << log_.all();
     ros::param::del("/bad_detector");
   }
+}
+
+TEST_F(DetectorNodeletTest, APointLimitOutsideItsRangeIsRefused) {
+  ros::param::set("/bad_detector/model_path", tmp_ / "detector.pt");
+  ros::param::set("/bad_detector/config", tmp_ / "small.yaml");
+  ros::param::set("/bad_detector/max_points", 10);
+  nodelet::Loader loader(false);
+  EXPECT_FALSE(test::loadNodelet(loader, "/bad_detector", "ret3d/DetectorNodelet"));
+  EXPECT_FALSE(log_.find({"refuses to start", "/bad_detector/max_points = 10", "[1000, 10000000]"}).empty())
+      << log_.all();
+  ros::param::del("/bad_detector");
 }
 
 TEST_F(DetectorNodeletTest, MissingModelIsRefused) {

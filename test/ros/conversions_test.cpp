@@ -322,6 +322,36 @@ TEST(ToCloud, OrganizedCloudWithRowPadding) {
   expectIntensityInUnitRange(cloud);
 }
 
+TEST(ToCloud, OverMaxPointsAnEvenSelectionOfExactlyThatManyIsKept) {
+  // Organized 8 x 125 = 1000 points, x = the point's row-major index; a limit of 300.
+  const auto fields = xyzAnd({{"intensity", 12, PointField::FLOAT32}});
+  constexpr std::uint32_t kWidth = 125, kHeight = 8;
+  auto pts = randomPoints(kWidth * kHeight, 1.0, 3);
+  for (std::size_t i = 0; i < pts.size(); ++i) pts[i]["x"] = static_cast<double>(i);
+  const sensor_msgs::PointCloud2 msg = buildCloud(fields, 16, pts, kWidth, kHeight, kWidth * 16);
+  CloudConversionOptions options;
+  options.max_points = 300;
+  CloudConversionReport report;
+  const PointCloud cloud = toCloud(msg, options, &report);
+  EXPECT_TRUE(report.thinned);
+  EXPECT_EQ(report.input_points, 1000u);
+  ASSERT_EQ(cloud.size(), 300u);
+  EXPECT_EQ(report.output_points, 300u);
+  // Evenly spread over every row: gaps of 3 or 4 indices, the whole index range covered.
+  for (std::size_t i = 1; i < cloud.size(); ++i) {
+    const float gap = cloud.points[i].x - cloud.points[i - 1].x;
+    EXPECT_TRUE(gap == 3.0f || gap == 4.0f) << "at " << i << ": " << gap;
+  }
+  EXPECT_LE(cloud.points.front().x, 3.0f);
+  EXPECT_GE(cloud.points.back().x, 996.0f);
+  // The same points every time; at or under the limit nothing is thinned.
+  const PointCloud again = toCloud(msg, options);
+  for (std::size_t i = 0; i < cloud.size(); ++i) EXPECT_EQ(again.points[i].x, cloud.points[i].x);
+  options.max_points = 1000;
+  EXPECT_EQ(toCloud(msg, options, &report).size(), 1000u);
+  EXPECT_FALSE(report.thinned);
+}
+
 TEST(ToCloud, Float64AndIntegerCoordinates) {
   const std::vector<FieldSpec> fields = {{"x", 0, PointField::FLOAT64},
                                          {"y", 8, PointField::FLOAT64},

@@ -36,6 +36,9 @@ struct CloudConversionOptions {
   double intensity_scale = 255.0;  // used by FixedScale only; must be > 0
   bool keep_time = true;           // fill PointCloud::time when the message has a time field
   bool keep_ring = true;           // fill PointCloud::ring when the message has a ring field
+  // 0: no limit. A message with more points is thinned evenly by index (row by row, the same points every time) to
+  // this many before conversion: CloudConversionReport::thinned says so.
+  std::size_t max_points = 0;
 };
 
 // What toCloud found and did; filled when a report is passed.
@@ -43,6 +46,7 @@ struct CloudConversionReport {
   std::size_t input_points = 0;       // width * height
   std::size_t output_points = 0;      // after dropping non-finite points
   std::size_t dropped_nonfinite = 0;  // points with a NaN or Inf coordinate
+  bool thinned = false;               // more than max_points: only max_points of the input points were read
   std::string intensity_field;        // "intensity", "i", "reflectivity", or empty when none
   std::string time_field;             // "time", "t", "timestamp", or empty
   bool has_ring = false;
@@ -55,7 +59,8 @@ struct CloudConversionReport {
 // else `reflectivity`; optional `ring`; optional time from `time`, else `t`, else `timestamp` (integer times are
 // nanoseconds, float times seconds; absolute times - above 1e6 s - become offsets from the header stamp). Any
 // numeric datatype, point_step and padding; is_bigendian respected; organized clouds (height > 1, row_step) read
-// row by row. Points with a non-finite coordinate are dropped.
+// row by row. Points with a non-finite coordinate are dropped. Above options.max_points, an even selection of that
+// many input points is converted.
 // Throws std::invalid_argument when x, y or z is missing or the message is malformed (data shorter than its
 // declared size, a field past point_step, an unknown datatype).
 PointCloud toCloud(const sensor_msgs::PointCloud2& msg, const CloudConversionOptions& options = {},

@@ -1,9 +1,11 @@
 // What every ret3d stage nodelet shares (the nodelets themselves: src/ros/*_nodelet.cpp; topics: ARCHITECTURE.md).
 //
 // StageNodelet<In>: a latest-frame slot and one worker thread. The subscriber callback only puts the message into the
-// slot (replacing, and counting as dropped, a message still waiting there), so the stage always works on the newest
-// frame and never builds up delay; the worker converts, calls the stage, converts and publishes. Messages travel as
-// boost::shared_ptr (zero-copy between nodelets of one manager). diagnostic_updater reports the StageMonitor at 1 Hz.
+// slot (replacing a message still waiting there, counted as dropped.superseded), so the stage always works on the
+// newest frame and never builds up delay; the worker converts, calls the stage, converts and publishes. Every message
+// is accounted for (include/ret3d/ros/diagnostics.h): answered, superseded, too old (~max_input_age) or an error in
+// the stage. Messages travel as boost::shared_ptr (zero-copy between nodelets of one manager). diagnostic_updater
+// reports the StageMonitor at 1 Hz.
 //
 // PoseSource: the sensor's pose in the fixed frame at a cloud's stamp from tf2; when the transform is missing it
 // degrades to the last pose it found for that frame (identity before the first), with a throttled warning.
@@ -18,6 +20,7 @@
 
 #include <chrono>
 #include <condition_variable>
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -95,7 +98,8 @@ class StageNodelet : public nodelet::Nodelet {
   // Reads the parameters, builds the stage, advertises, and ends with start(input topic). Whatever it throws stops
   // the nodelet from starting, with the message logged (FATAL) and passed on to the loader.
   virtual void setup() = 0;
-  // The stage's work on one frame (worker thread). Exceptions are caught, logged throttled and counted.
+  // The stage's work on one frame (worker thread): it publishes an output for every frame it returns from.
+  // Exceptions are caught, logged throttled and counted as dropped.error.
   virtual void process(const InConstPtr& msg) = 0;
 
   void onInit() final {
@@ -109,6 +113,7 @@ class StageNodelet : public nodelet::Nodelet {
 
   // Called at the end of the subclass's onInit, after its parameters and stage are ready.
   void start(const std::string& input_topic) {
+    stage_params_ = loadStageParams(getPrivateNodeHandle());
     routeStageLogToRos();
     ros::NodeHandle& nh = getNodeHandle();
     updater_.reset(new diagnostic_updater::Updater(nh, getPrivateNodeHandle(), getName()));
@@ -117,8 +122,10 @@ class StageNodelet : public nodelet::Nodelet {
     diagnostics_timer_ = nh.createWallTimer(ros::WallDuration(1.0),
                                             [this](const ros::WallTimerEvent&) { updater_->force_update(); });
     worker_ = std::thread([this] { workerLoop(); });
-    // Queue size 1: the latest frame wins; the slot below counts what is replaced.
-    subscriber_ = nh.subscribe<In>(input_topic, 1, &StageNodelet::onMessage, this);
+    // The latest frame wins in the slot below, which counts what it replaces. The subscriber's own queue is deeper
+    // than one on purpose: roscpp drops from a full queue without telling anyone, and onMessage is cheap, so this
+    // queue only holds messages for the moment until the manager's callback threads run.
+    subscriber_ = nh.subscribe<In>(input_topic, kSubscriberQueue, &StageNodelet::onMessage, this);
     NODELET_INFO_STREAM(getName() << ": listening on " << subscriber_.getTopic());
   }
 
@@ -134,28 +141,48 @@ class StageNodelet : public nodelet::Nodelet {
     if (worker_.joinable()) worker_.join();
   }
 
-  // A degradation the stage worked around: counted, reported on /diagnostics, logged throttled (every 5 s per kind).
-  void degraded(const std::string& kind, const std::string& what) {
-    monitor_.degraded(what);
-    const ros::WallTime now = ros::WallTime::now();
-    auto it = last_warned_.find(kind);
-    if (it == last_warned_.end() || (now - it->second).toSec() >= 5.0) {
-      last_warned_[kind] = now;
-      NODELET_WARN_STREAM(getName() << ": " << what);
-    }
+  // A degradation the stage worked around on a frame it answers: counted under degraded.<kind> (snake_case),
+  // reported on /diagnostics, logged throttled (every 5 s per kind, or per `throttle_key` when given).
+  void degraded(const std::string& kind, const std::string& what, const std::string& throttle_key = "") {
+    monitor_.degraded(kind, what);
+    warnThrottled(throttle_key.empty() ? kind : throttle_key, what);
   }
 
   StageMonitor monitor_;
 
  private:
+  static constexpr std::uint32_t kSubscriberQueue = 10;
+
+  void warnThrottled(const std::string& key, const std::string& what) {
+    const ros::WallTime now = ros::WallTime::now();
+    auto it = last_warned_.find(key);
+    if (it == last_warned_.end() || (now - it->second).toSec() >= 5.0) {
+      last_warned_[key] = now;
+      NODELET_WARN_STREAM(getName() << ": " << what);
+    }
+  }
+
+  void drop(DropReason reason, const std::string& what) {
+    monitor_.dropped(reason);
+    warnThrottled(std::string("dropped.") + dropReasonName(reason), what);
+  }
+
   void onMessage(const InConstPtr& msg) {
     monitor_.input();
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      if (pending_) monitor_.dropped();
+      // Not logged: under load this is the policy working, and /diagnostics says how often.
+      if (pending_) monitor_.dropped(DropReason::Superseded);
       pending_ = msg;
     }
     cv_.notify_one();
+  }
+
+  // Too old to be worth an answer (~max_input_age > 0): how old, or a negative number.
+  double tooOld(const ros::Time& stamp) const {
+    if (stage_params_.max_input_age <= 0.0) return -1.0;
+    const double age = (ros::Time::now() - stamp).toSec();
+    return age > stage_params_.max_input_age ? age : -1.0;
   }
 
   void workerLoop() {
@@ -167,12 +194,19 @@ class StageNodelet : public nodelet::Nodelet {
         if (stop_) return;
         msg.swap(pending_);
       }
+      const double age = tooOld(msg->header.stamp);
+      if (age >= 0.0) {
+        drop(DropReason::TooOld, "frame at " + std::to_string(msg->header.stamp.toSec()) + " is " +
+                                     std::to_string(age) + " s old (> ~max_input_age " +
+                                     std::to_string(stage_params_.max_input_age) + " s): dropped");
+        continue;
+      }
       const auto t0 = std::chrono::steady_clock::now();
       try {
         process(msg);
       } catch (const std::exception& e) {
-        degraded("exception", std::string("frame at ") + std::to_string(msg->header.stamp.toSec()) +
-                                  " not processed: " + e.what());
+        drop(DropReason::Error,
+             std::string("frame at ") + std::to_string(msg->header.stamp.toSec()) + " not processed: " + e.what());
         continue;
       }
       const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -190,6 +224,7 @@ class StageNodelet : public nodelet::Nodelet {
   std::condition_variable cv_;
   InConstPtr pending_;
   bool stop_ = false;
+  StageParams stage_params_;
   std::map<std::string, ros::WallTime> last_warned_;  // worker thread only
 };
 

@@ -64,11 +64,19 @@ struct PoseParams {
   double tf_timeout = 0.05;  // s to wait for a transform at the cloud's stamp
 };
 
+// What every stage nodelet shares (read by StageNodelet::start, include/ret3d/ros/nodelets.h).
+struct StageParams {
+  // s: a frame whose stamp is older than this when the stage's worker takes it is dropped (dropped.too_old) instead
+  // of answered late. 0 (the default): never; a bag played without --clock and use_sim_time has old stamps.
+  double max_input_age = 0.0;
+};
+
 struct DetectorNodeletParams {
   DetectorOptions detector;          // ~model_path with ~config (YAML file; empty: the config stored in the model
                                      // file), then ~threads, ~score_threshold, ~nms_iou, ~nms_voting_iou,
                                      // ~iou_score_power, ~max_detections
-  CloudConversionOptions cloud;      // ~intensity_scaling (auto|datatype|observed_max|fixed), ~intensity_scale
+  CloudConversionOptions cloud;      // ~intensity_scaling (auto|datatype|observed_max|fixed), ~intensity_scale,
+                                     // ~max_points (500000; a bigger cloud is thinned to this many points)
   PoseParams pose;
   double max_sweep_gap = 0.25;       // s: an older previous sweep is not used (LWD-3D's second sweep is 0.1 s back)
 };
@@ -92,6 +100,7 @@ struct MarkerNodeletParams {
   PoseParams pose;
 };
 
+StageParams loadStageParams(const ros::NodeHandle& private_nh);
 DetectorNodeletParams loadDetectorNodeletParams(const ros::NodeHandle& private_nh);
 IntraRMNodeletParams loadIntraRMNodeletParams(const ros::NodeHandle& private_nh);
 TrackerNodeletParams loadTrackerNodeletParams(const ros::NodeHandle& private_nh);
