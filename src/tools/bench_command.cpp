@@ -51,19 +51,20 @@ struct BenchArgs {
   bool no_markers = false;
   NodeletBenchOptions nodelets;  // --bag through the nodelets: the options only that run has
   std::string baseline;          // a folder of models timed in the same run, for the new/baseline ratio
+  std::string baseline_config;   // the baseline detector's YAML (empty: the config stored in its model file)
 };
 
-// The baseline's pipeline: the detector of `dir` with its own configuration (stored in the model file) and its own
-// grid; its IntraRM / InterRM where `dir` has them, else the same as the new pipeline's. Stage list, threads, score
-// threshold and tracker config are the run's.
-PipelineConfig baselineConfig(const PipelineConfig& p, const std::string& dir) {
+// The baseline's pipeline: the detector of `dir` with its own configuration (stored in the model file, or `config`)
+// and its own grid; its IntraRM / InterRM where `dir` has them, else the same as the new pipeline's. Stage list,
+// threads, score threshold and tracker config are the run's.
+PipelineConfig baselineConfig(const PipelineConfig& p, const std::string& dir, const std::string& config) {
   if (!fs::is_directory(dir)) throw std::runtime_error("--baseline " + dir + ": no such folder");
   const fs::path detector = fs::path(dir) / "detector.pt";
   if (!fs::is_regular_file(detector))
     throw std::runtime_error("--baseline " + dir + ": no detector.pt there (a folder of models, e.g. models/lwd3d)");
   PipelineConfig b = p;
   b.detector_model = detector.string();
-  b.detector_config.clear();
+  b.detector_config = config;
   b.grid_extent.clear();
   for (auto [name, file] : {std::pair{"intra_rm.pt", &b.intra_model}, std::pair{"inter_rm.pt", &b.inter_model}})
     if (fs::is_regular_file(fs::path(dir) / name)) *file = (fs::path(dir) / name).string();
@@ -283,7 +284,7 @@ NodeletBenchOptions nodeletOptions(const BenchArgs& a, const PipelineConfig& p) 
 // node), then the new models in this one, one after the other on the same bag; the child's figures come back
 // through a pipe.
 int benchNodeletsAgainstBaseline(const BenchArgs& a) {
-  const PipelineConfig base_config = baselineConfig(a.pipeline, a.baseline);
+  const PipelineConfig base_config = baselineConfig(a.pipeline, a.baseline, a.baseline_config);
   NodeletBenchOptions base = nodeletOptions(a, base_config);
   NodeletBenchOptions now = nodeletOptions(a, a.pipeline);
   if (!now.json.empty()) base.json = (fs::path(now.json).parent_path() / fs::path(now.json).stem()).string() +
@@ -374,7 +375,7 @@ int runBench(BenchArgs a) {
   if (frames.empty()) throw std::runtime_error("no frames to time");
   OfflinePipeline p(a.pipeline);
   std::optional<OfflinePipeline> baseline;
-  if (!a.baseline.empty()) baseline.emplace(baselineConfig(a.pipeline, a.baseline));
+  if (!a.baseline.empty()) baseline.emplace(baselineConfig(a.pipeline, a.baseline, a.baseline_config));
   std::size_t points = 0;
   for (const BenchFrame& f : frames) points += f.cloud.size();
   std::cout << "bench: " << p.describe() << "\n";
@@ -476,6 +477,8 @@ CommandRegistrar reg("bench", "time the pipeline: through the nodelets on a bag,
                  "the new models only); prints new/baseline of the detector's median and p95. --bag: the baseline "
                  "first in a child process, then the new models (its --json goes to <name>.baseline.json); --data, "
                  "--in-process: both pipelines on each frame in turn");
+  app.add_option("--baseline-detector-config", a->baseline_config,
+                 "--baseline: the baseline detector's YAML (default: the config stored in its model file)");
   app.add_option("--topic", a->topic, "bag topic (default: the first PointCloud2 topic)");
   app.add_option("--models", p.models, "folder with detector.pt, intra_rm.pt, inter_rm.pt (e.g. models/lwd3d; "
                                  "--bag: that is the default, as in launch/ret3d.launch)");
