@@ -11,11 +11,12 @@
 #   --load N     cores kept busy meanwhile (default 0)
 #   --out DIR    soak.json, soak.tsv, soak.log and soak.png go there (default out/soak)
 #   BENCH ARGS   passed on to `ret3d bench` (e.g. --models DIR, --stages base,track)
+# PLOT_ONLY=1: redraw the plot of the soak.tsv already in --out, without running the bench.
 # Exits 0 when every check passes, 1 when one fails, 2 on a usage or run error.
 set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 BAG="$ROOT/data/demo/0000.bag" FRAMES=10000 EVERY=500 LOAD=0 OUT="$ROOT/out/soak"
-usage() { sed -n '7,13p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '7,14p' "$0" | sed 's/^# \{0,1\}//'; }
 while (($#)); do
   case "$1" in
     --bag) BAG=$(realpath "${2:?--bag needs a file}"); shift ;;
@@ -29,7 +30,7 @@ while (($#)); do
   esac
   shift
 done
-[[ -f "$BAG" ]] || { echo "soak: no bag at $BAG (scripts/demo.sh simulates data/demo/0000.bag; or give --bag)" >&2; exit 2; }
+[[ -n "${PLOT_ONLY:-}" || -f "$BAG" ]] || { echo "soak: no bag at $BAG (scripts/demo.sh simulates data/demo/0000.bag; or give --bag)" >&2; exit 2; }
 command -v gnuplot >/dev/null || { echo "soak: gnuplot is missing (scripts/setup.sh installs gnuplot-nox)" >&2; exit 2; }
 # ROS's setup scripts read unset variables: source them without nounset.
 set +u
@@ -37,13 +38,18 @@ source "$ROOT/scripts/env.sh"
 set -u
 mkdir -p "$OUT"
 
-rm -f "$OUT/soak.json" "$OUT/soak.tsv"
-set +e
-ret3d bench --bag "$BAG" --loop-frames "$FRAMES" --soak-every "$EVERY" --load "$LOAD" --json "$OUT/soak.json" "$@" \
-  2>&1 | tee "$OUT/soak.log"
-RC=${PIPESTATUS[0]}
-set -e
-[[ $RC -eq 0 && -f "$OUT/soak.tsv" ]] || { echo "soak: the bench failed (log: $OUT/soak.log)" >&2; exit 2; }
+if [[ -z "${PLOT_ONLY:-}" ]]; then
+  rm -f "$OUT/soak.json" "$OUT/soak.tsv"
+  set +e
+  ret3d bench --bag "$BAG" --loop-frames "$FRAMES" --soak-every "$EVERY" --load "$LOAD" --json "$OUT/soak.json" "$@" \
+    2>&1 | tee "$OUT/soak.log"
+  RC=${PIPESTATUS[0]}
+  set -e
+  [[ $RC -eq 0 && -f "$OUT/soak.tsv" ]] || { echo "soak: the bench failed (log: $OUT/soak.log)" >&2; exit 2; }
+else
+  [[ -f "$OUT/soak.tsv" && -f "$OUT/soak.log" ]] || { echo "soak: PLOT_ONLY: no soak.tsv and soak.log in $OUT" >&2; exit 2; }
+  FRAMES=$(tail -n 1 "$OUT/soak.tsv" | cut -f 1)
+fi
 
 # The checks' lines of the log as the plot's subtitle.
 CHECKS=$(grep '^soak check:' "$OUT/soak.log" | sed 's/^soak check: //; s/"/\\"/g' | awk '{printf "%s\\n", $0}')
@@ -62,11 +68,13 @@ plot "$OUT/soak.tsv" u 1:3 w linespoints pt 7 ps 0.6 lw 2 lc rgb "#1f77b4" t "Vm
 set title "open file descriptors and threads of the manager process"
 set ylabel "count"
 set yrange [0:*]
+set key bottom right
 plot "$OUT/soak.tsv" u 1:4 w linespoints pt 7 ps 0.6 lw 2 lc rgb "#2ca02c" t "fds", \
      "" u 1:5 w linespoints pt 5 ps 0.6 lw 2 lc rgb "#9467bd" t "threads"
 set title "latency per window of $EVERY frames (end-to-end: cloud stamp to the last stage's output); the machine's load"
 set ylabel "ms"
 set y2label "1-minute load average (2 cores)"
+set key top right
 set y2range [0:*]
 set y2tics
 plot "$OUT/soak.tsv" u 1:7 w linespoints pt 7 ps 0.6 lw 2 lc rgb "#1f77b4" t "end-to-end p50", \

@@ -495,11 +495,12 @@ CommandRegistrar reg("bench", "time the pipeline: through the nodelets on a bag,
   app.add_option("--threads", p.threads, "CPU threads for libtorch")->capture_default_str();
   app.add_option("--warmup", a->warmup, "untimed runs first (--bag: clouds left out of the statistics)")->capture_default_str();
   app.add_option("--min-runs", a->min_runs, "timed runs (frames are cycled)")->capture_default_str();
-  app.add_option("--max-frames", a->max_frames, "frames read at most")->capture_default_str();
+  app.add_option("--max-frames", a->max_frames, "frames read at most (--loop-frames: clouds per pass of the bag)")->capture_default_str();
   app.add_option("--objects", a->objects, "without the base stage: object counts of the synthetic frames")
       ->capture_default_str();
   app.add_option("--json", a->json, "write {\"<stage>\": {\"median_ms\", \"p95_ms\"}, ..., \"total\": {...}} (--bag: "
-                                    "..., \"end_to_end\": {...}, \"frames\", \"dropped\", \"cpu_cores\")");
+                                    "..., \"end_to_end\": {...}, \"frames\", \"dropped\", \"cpu_cores\"; --loop-frames: "
+                                    "{\"samples\": [...], \"checks\": {...}}, default out/soak/soak.json)");
   return [a]() {
     if (a->nodelets.loop_frames > 0 && a->json.empty()) a->json = "out/soak/soak.json";
     return runBench(*a);

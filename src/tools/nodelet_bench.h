@@ -6,6 +6,7 @@
 // /tf_static as it is. The manager records when each stage's output arrives for each cloud stamp: per-stage times,
 // end-to-end latency (cloud stamp to /objects), frames without output, and the CPU the manager process used.
 // A private ROS master (rosmaster --core on a free port) keeps the run apart from any ROS system on the machine.
+// The soak (--loop-frames) plays the bag in a loop and samples this process, the one hosting the nodelets, as it goes.
 #pragma once
 
 #include <cstddef>
