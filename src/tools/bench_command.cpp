@@ -6,14 +6,22 @@
 // tracking or object folder, a folder of .bin scans, or the PointCloud2 messages of a bag. Frames are cycled until
 // --min-runs timed runs, so a short drive still gives a p95.
 // Neither: the stages after the detector timed on synthetic frames of --objects objects.
+// --loop-frames N (--bag): the soak, N clouds through the nodelets with memory, descriptors and latency sampled.
+// --load N: N spinning processes meanwhile. --baseline DIR: another set of models timed in the same run, and the
+// ratio new / baseline of the detector's median and p95.
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
-#include <sstream>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <optional>
 #include <random>
+#include <sstream>
 #include <thread>
 
 #include <rosbag/bag.h>
@@ -42,7 +50,34 @@ struct BenchArgs {
   bool in_process = false;  // --bag: time the stages in this process instead of through the nodelets
   bool no_markers = false;
   NodeletBenchOptions nodelets;  // --bag through the nodelets: the options only that run has
+  std::string baseline;          // a folder of models timed in the same run, for the new/baseline ratio
+  std::string baseline_config;   // the baseline detector's YAML (empty: the config stored in its model file)
 };
+
+// The baseline's pipeline: the detector of `dir` with its own configuration (stored in the model file, or `config`)
+// and its own grid; its IntraRM / InterRM where `dir` has them, else the same as the new pipeline's. Stage list,
+// threads, score threshold and tracker config are the run's.
+PipelineConfig baselineConfig(const PipelineConfig& p, const std::string& dir, const std::string& config) {
+  if (!fs::is_directory(dir)) throw std::runtime_error("--baseline " + dir + ": no such folder");
+  const fs::path detector = fs::path(dir) / "detector.pt";
+  if (!fs::is_regular_file(detector))
+    throw std::runtime_error("--baseline " + dir + ": no detector.pt there (a folder of models, e.g. models/lwd3d)");
+  PipelineConfig b = p;
+  b.detector_model = detector.string();
+  b.detector_config = config;
+  b.grid_extent.clear();
+  for (auto [name, file] : {std::pair{"intra_rm.pt", &b.intra_model}, std::pair{"inter_rm.pt", &b.inter_model}})
+    if (fs::is_regular_file(fs::path(dir) / name)) *file = (fs::path(dir) / name).string();
+  return b;
+}
+
+// "median 45.1 / 40.2 ms = 1.12x" for new and baseline figures.
+std::string ratioText(const char* what, double now, double base) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(1) << what << " " << now << " / " << base << " ms = " << std::setprecision(2)
+    << (base > 0 ? now / base : 0.0) << "x";
+  return s.str();
+}
 
 // One input frame: the scan and the ego motion from the previous one (identity when unknown).
 struct BenchFrame {
@@ -162,7 +197,9 @@ void writeJson(const std::string& path, const std::string& text) {
 // objects move at constant velocity, so tracks persist and their histories fill up (warm-up: at least the history
 // length, in frames).
 int benchSynthetic(const BenchArgs& a) {
+  if (!a.baseline.empty()) throw std::runtime_error("--baseline compares detectors: --stages must start with base");
   OfflinePipeline p(a.pipeline);
+  const std::optional<BusyLoad> busy = a.nodelets.load > 0 ? std::make_optional<BusyLoad>(a.nodelets.load) : std::nullopt;
   std::cout << "bench: " << p.describe() << "; " << a.pipeline.threads << " threads, " << a.warmup
             << " warm-up and " << a.min_runs << " timed frames per case\n";
   std::cout << std::left << std::setw(26) << "case" << std::right << std::setw(12) << "median ms" << std::setw(12)
@@ -222,9 +259,8 @@ std::string nodeletModel(const std::string& explicit_path, const std::string& mo
   return path;
 }
 
-int benchNodelets(const BenchArgs& a) {
+NodeletBenchOptions nodeletOptions(const BenchArgs& a, const PipelineConfig& p) {
   NodeletBenchOptions o = a.nodelets;
-  const PipelineConfig& p = a.pipeline;
   auto has = [&](const char* s) { return std::find(p.stages.begin(), p.stages.end(), s) != p.stages.end(); };
   o.bag = a.bag;
   o.topic = a.topic;
@@ -241,12 +277,94 @@ int benchNodelets(const BenchArgs& a) {
   o.max_frames = a.max_frames;
   o.json = a.json;
   o.markers = !a.no_markers;
-  return runNodeletBench(o);
+  return o;
+}
+
+// The baseline through the nodelets in a child process (forked before this one starts ROS: a process runs one ROS
+// node), then the new models in this one, one after the other on the same bag; the child's figures come back
+// through a pipe.
+int benchNodeletsAgainstBaseline(const BenchArgs& a) {
+  const PipelineConfig base_config = baselineConfig(a.pipeline, a.baseline, a.baseline_config);
+  NodeletBenchOptions base = nodeletOptions(a, base_config);
+  NodeletBenchOptions now = nodeletOptions(a, a.pipeline);
+  if (!now.json.empty()) base.json = (fs::path(now.json).parent_path() / fs::path(now.json).stem()).string() +
+                                     ".baseline" + fs::path(now.json).extension().string();
+  int fds[2];
+  if (pipe(fds) != 0) throw std::runtime_error(std::string("pipe: ") + std::strerror(errno));
+  std::cout << "bench: 1/2 the baseline models (" << base.detector_model << ")" << std::endl;
+  const pid_t pid = fork();
+  if (pid < 0) throw std::runtime_error(std::string("fork: ") + std::strerror(errno));
+  if (pid == 0) {
+    close(fds[0]);
+    int rc = 1;
+    try {
+      NodeletBenchResult r;
+      rc = runNodeletBench(base, &r);
+      std::ostringstream text;
+      text << std::setprecision(17) << r.base_p50 << " " << r.base_p95 << " " << r.base_processing_p50 << " "
+           << r.base_processing_p95 << " " << r.end_to_end_p50 << " " << r.end_to_end_p95 << "\n";
+      const std::string t = text.str();
+      if (write(fds[1], t.data(), t.size()) != static_cast<ssize_t>(t.size())) rc = 1;
+    } catch (const std::exception& e) {
+      std::cerr << "bench: the baseline run: " << e.what() << std::endl;
+    }
+    std::cout.flush();
+    _exit(rc);
+  }
+  close(fds[1]);
+  std::string text;
+  char buffer[256];
+  for (ssize_t n; (n = read(fds[0], buffer, sizeof(buffer))) > 0;) text.append(buffer, static_cast<std::size_t>(n));
+  close(fds[0]);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  NodeletBenchResult b;
+  std::istringstream in(text);
+  in >> b.base_p50 >> b.base_p95 >> b.base_processing_p50 >> b.base_processing_p95 >> b.end_to_end_p50 >>
+      b.end_to_end_p95;
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || !in)
+    throw std::runtime_error("the baseline run failed (see its message above); the new models were not timed");
+
+  std::cout << "bench: 2/2 the new models (" << now.detector_model << ")" << std::endl;
+  NodeletBenchResult n;
+  const int rc = runNodeletBench(now, &n);
+  std::cout << "bench: new / baseline, one run after the other on this bag:\n"
+            << "  " << ratioText("detector (/points to /detections) median", n.base_p50, b.base_p50) << ", "
+            << ratioText("p95", n.base_p95, b.base_p95) << "\n";
+  if (n.base_processing_p50 >= 0 && b.base_processing_p50 >= 0)
+    std::cout << "  " << ratioText("detector processing (its /diagnostics) median", n.base_processing_p50,
+                                   b.base_processing_p50)
+              << ", " << ratioText("p95", n.base_processing_p95, b.base_processing_p95) << "\n";
+  std::cout << "  " << ratioText("end-to-end median", n.end_to_end_p50, b.end_to_end_p50) << ", "
+            << ratioText("p95", n.end_to_end_p95, b.end_to_end_p95) << "\n";
+  return rc;
+}
+
+int benchNodelets(const BenchArgs& a) {
+  if (!a.baseline.empty()) {
+    if (a.nodelets.loop_frames > 0) throw std::runtime_error("--baseline and --loop-frames: give one of them");
+    return benchNodeletsAgainstBaseline(a);
+  }
+  return runNodeletBench(nodeletOptions(a, a.pipeline));
+}
+
+// The base detector per frame (BEV + network + decoding + NMS + point refinement), the figure of the latency budget.
+std::vector<double> baseTimes(const OfflinePipeline& p) {
+  const auto& t = p.times().all();
+  std::vector<double> base;
+  for (std::size_t i = 0; i < t.at("bev").size(); ++i)
+    base.push_back(t.at("bev")[i] + t.at("network")[i] + t.at("decode")[i] + t.at("nms")[i] + t.at("refine")[i]);
+  return base;
 }
 
 int runBench(BenchArgs a) {
   a.pipeline.stages = parseStages(a.stages);
-  if (!a.bag.empty() && a.data.empty() && !a.in_process) return benchNodelets(a);
+  if (a.nodelets.load < 0) throw std::runtime_error("--load must be >= 0, not " + std::to_string(a.nodelets.load));
+  const bool nodelets = !a.bag.empty() && a.data.empty() && !a.in_process;
+  if (a.nodelets.loop_frames != 0 && !nodelets)
+    throw std::runtime_error("--loop-frames (the soak) plays a bag through the nodelets: give --bag FILE without "
+                             "--in-process or --data");
+  if (nodelets) return benchNodelets(a);
   if (!a.pipeline.stages.empty() && a.pipeline.stages.front() != "base" && a.data.empty() && a.bag.empty())
     return benchSynthetic(a);
   if (a.data.empty() == a.bag.empty()) throw std::runtime_error("give exactly one of --data DIR and --bag FILE");
@@ -256,18 +374,27 @@ int runBench(BenchArgs a) {
   const std::vector<BenchFrame> frames = a.bag.empty() ? framesFromData(a) : framesFromBag(a);
   if (frames.empty()) throw std::runtime_error("no frames to time");
   OfflinePipeline p(a.pipeline);
+  std::optional<OfflinePipeline> baseline;
+  if (!a.baseline.empty()) baseline.emplace(baselineConfig(a.pipeline, a.baseline, a.baseline_config));
   std::size_t points = 0;
   for (const BenchFrame& f : frames) points += f.cloud.size();
-  std::cout << "bench: " << p.describe() << "\n"
+  std::cout << "bench: " << p.describe() << "\n";
+  if (baseline) std::cout << "bench: baseline, run on each frame right after the new pipeline: " << baseline->describe()
+                          << "\n";
+  std::cout
             << "bench: " << frames.size() << " frames, " << points / frames.size() << " points per scan on average, "
             << a.pipeline.threads << " threads, " << a.warmup << " warm-up runs, at least " << a.min_runs
             << " timed runs; " << std::thread::hardware_concurrency() << " cores here\n";
+  const std::optional<BusyLoad> busy = a.nodelets.load > 0 ? std::make_optional<BusyLoad>(a.nodelets.load) : std::nullopt;
+  if (busy) std::cout << "bench: " << a.nodelets.load << " busy processes spinning (--load)\n";
   int runs = 0, pass = 0;
   std::size_t boxes = 0;
   while (runs < a.min_runs + a.warmup) {
     p.reset();
+    if (baseline) baseline->reset();
     for (std::size_t i = 0; i < frames.size() && runs < a.min_runs + a.warmup; ++i, ++runs) {
       if (runs == a.warmup) p.clearTimes();
+      if (runs == a.warmup && baseline) baseline->clearTimes();
       const BenchFrame& f = frames[i];
       const bool prev = i > 0 && f.follows;
       const Eigen::Isometry3d prev_to_current =
@@ -276,6 +403,8 @@ int runBench(BenchArgs a) {
       const double stamp = 0.1 * static_cast<double>(i) + 1000.0 * pass;
       const Detections d = p.run(&f.cloud, prev ? &frames[i - 1].cloud : nullptr, prev_to_current, {}, stamp, f.pose);
       if (runs >= a.warmup) boxes += d.size();
+      // Interleaved frame by frame, so a busy spell of the shared machine falls on both alike.
+      if (baseline) baseline->run(&f.cloud, prev ? &frames[i - 1].cloud : nullptr, prev_to_current, {}, stamp, f.pose);
     }
     ++pass;
   }
@@ -287,12 +416,21 @@ int runBench(BenchArgs a) {
   bool first = true;
   for (const char* stage : {"bev", "network", "decode", "nms", "refine", "intra", "track", "inter", "total"})
     if (t.count(stage)) printRow(stage, summarise(t.at(stage)), &json, &first);
-  // The base detector alone (BEV + network + decoding + NMS + point refinement), the figure of the latency budget.
-  std::vector<double> base;
-  for (std::size_t i = 0; i < t.at("bev").size(); ++i)
-    base.push_back(t.at("bev")[i] + t.at("network")[i] + t.at("decode")[i] + t.at("nms")[i] + t.at("refine")[i]);
-  printRow("base", summarise(base), &json, &first);
+  const Summary base = summarise(baseTimes(p));
+  printRow("base", base, &json, &first);
   std::cout << "(base = bev + network + decode + nms + refine)\n";
+  if (baseline) {
+    const auto& bt = baseline->times().all();
+    for (const char* stage : {"network", "total"})
+      if (bt.count(stage)) printRow(std::string("baseline_") + stage, summarise(bt.at(stage)), &json, &first);
+    const Summary b = summarise(baseTimes(*baseline));
+    printRow("baseline_base", b, &json, &first);
+    std::cout << "bench: new / baseline, interleaved frame by frame: "
+              << ratioText("detector (base) median", base.median, b.median) << ", " << ratioText("p95", base.p95, b.p95)
+              << "\n";
+    json << ", \"base_ratio_median\": " << (b.median > 0 ? base.median / b.median : 0.0)
+         << ", \"base_ratio_p95\": " << (b.p95 > 0 ? base.p95 / b.p95 : 0.0);
+  }
   const Detector* det = p.detector();
   const std::string model = det->options().inference.model_path;
   std::cout << "detector: " << det->parameterCount() << " parameters, model file " << fs::file_size(model)
@@ -320,6 +458,27 @@ CommandRegistrar reg("bench", "time the pipeline: through the nodelets on a bag,
       ->capture_default_str();
   app.add_option("--tail", n.tail, "--bag: s to wait after the last cloud for its outputs")->capture_default_str();
   app.add_flag("--no-markers", a->no_markers, "--bag: without the MarkerNodelet (the launch file loads it)");
+  app.add_option("--loop-frames", n.loop_frames,
+                 "--bag: the soak: the bag played in a loop through the nodelets until N clouds have been played "
+                 "(at the bag's rate); every --soak-every clouds this process's resident memory, open file "
+                 "descriptors, threads and the latencies since the last sample are printed; at the end the checks "
+                 "(memory from frame 1000 to the end < +5 %, same descriptor count, end-to-end p95 of the last 1000 "
+                 "frames <= +10 % of the first 1000; a shorter run uses half its length). Writes --json (default "
+                 "out/soak/soak.json) and a table for plots beside it (.tsv). Exit code 0 when the run completed, "
+                 "whatever the checks say (scripts/soak.sh fails on them); 0: play once")
+      ->capture_default_str();
+  app.add_option("--soak-every", n.soak_every, "--loop-frames: clouds per sample")->capture_default_str();
+  app.add_option("--load", n.load, "busy processes, one spinning per core, while timing (--bag: from the start of "
+                                   "the replay to its end), for figures under a reproducible load")
+      ->capture_default_str();
+  app.add_option("--baseline", a->baseline,
+                 "a folder of models (detector.pt; intra_rm.pt, inter_rm.pt when there, else the new ones) timed in "
+                 "the same run, with its detector's own config and grid (--detector-config, --grid-extent apply to "
+                 "the new models only); prints new/baseline of the detector's median and p95. --bag: the baseline "
+                 "first in a child process, then the new models (its --json goes to <name>.baseline.json); --data, "
+                 "--in-process: both pipelines on each frame in turn");
+  app.add_option("--baseline-detector-config", a->baseline_config,
+                 "--baseline: the baseline detector's YAML (default: the config stored in its model file)");
   app.add_option("--topic", a->topic, "bag topic (default: the first PointCloud2 topic)");
   app.add_option("--models", p.models, "folder with detector.pt, intra_rm.pt, inter_rm.pt (e.g. models/lwd3d; "
                                  "--bag: that is the default, as in launch/ret3d.launch)");
@@ -336,12 +495,16 @@ CommandRegistrar reg("bench", "time the pipeline: through the nodelets on a bag,
   app.add_option("--threads", p.threads, "CPU threads for libtorch")->capture_default_str();
   app.add_option("--warmup", a->warmup, "untimed runs first (--bag: clouds left out of the statistics)")->capture_default_str();
   app.add_option("--min-runs", a->min_runs, "timed runs (frames are cycled)")->capture_default_str();
-  app.add_option("--max-frames", a->max_frames, "frames read at most")->capture_default_str();
+  app.add_option("--max-frames", a->max_frames, "frames read at most (--loop-frames: clouds per pass of the bag)")->capture_default_str();
   app.add_option("--objects", a->objects, "without the base stage: object counts of the synthetic frames")
       ->capture_default_str();
   app.add_option("--json", a->json, "write {\"<stage>\": {\"median_ms\", \"p95_ms\"}, ..., \"total\": {...}} (--bag: "
-                                    "..., \"end_to_end\": {...}, \"frames\", \"dropped\", \"cpu_cores\")");
-  return [a]() { return runBench(*a); };
+                                    "..., \"end_to_end\": {...}, \"frames\", \"dropped\", \"cpu_cores\"; --loop-frames: "
+                                    "{\"samples\": [...], \"checks\": {...}}, default out/soak/soak.json)");
+  return [a]() {
+    if (a->nodelets.loop_frames > 0 && a->json.empty()) a->json = "out/soak/soak.json";
+    return runBench(*a);
+  };
 });
 
 }  // namespace

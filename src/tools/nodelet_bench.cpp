@@ -24,15 +24,18 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <deque>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
+#include <utility>
 
 #include "ret3d/DetectionArray.h"
 #include "ret3d/Object3DArray.h"
@@ -55,6 +58,7 @@ struct BagPlan {
   std::size_t clouds = 0;          // clouds to play (at most --max-frames)
   ros::Time start;                 // record time of the first message played (cloud, /tf or /tf_static)
   double duration = 0;             // s of bag time from start to the last cloud played
+  double first_cloud = 0;          // s of bag time from start to the first cloud
   double cloud_rate_hz = 0;        // the clouds' own rate
   double stamp_skew = 0;           // header stamps minus record times, when they come from another clock (else 0)
   bool tf = false, tf_static = false;
@@ -97,6 +101,7 @@ BagPlan scanBag(const NodeletBenchOptions& o) {
     plan.start = played.size() ? played.begin()->getTime() : first;
     plan.start = std::min(plan.start, first);
     plan.duration = (last - plan.start).toSec();
+    plan.first_cloud = (first - plan.start).toSec();
     if (plan.clouds > 1) plan.cloud_rate_hz = static_cast<double>(plan.clouds - 1) / std::max(1e-9, (last - first).toSec());
   } catch (const rosbag::BagException& e) {
     throw std::runtime_error(o.bag + ": " + e.what());
@@ -244,29 +249,40 @@ int playBag(const NodeletBenchOptions& o, const BagPlan& plan, int go_fd) {
   if (plan.tf) topics.push_back(kTf);
   if (plan.tf_static) topics.push_back(kTfStatic);
   rosbag::View view(bag, rosbag::TopicQuery(topics));
+  // --loop-frames: pass k is the bag shifted by k periods, a period being the clouds' span plus one cloud interval,
+  // so the stamps keep increasing at the bag's rate across the seam (the ego pose jumps back to the bag's start).
+  const std::size_t total = o.loop_frames > 0 ? static_cast<std::size_t>(o.loop_frames) : plan.clouds;
+  const double period =
+      plan.duration - plan.first_cloud + (plan.cloud_rate_hz > 0 ? 1.0 / plan.cloud_rate_hz : 0.1);
   std::size_t clouds = 0;
-  for (const rosbag::MessageInstance& m : view) {
-    if (!ros::ok()) break;
-    if (m.getTopic() == plan.topic) {
-      if (clouds >= plan.clouds) break;
-      const auto msg = m.instantiate<sensor_msgs::PointCloud2>();
-      if (!msg) continue;
-      msg->header.stamp = wall(msg->header.stamp - ros::Duration(plan.stamp_skew));
-      waitUntil(wall(m.getTime()));
-      points.publish(msg);
-      ++clouds;
-    } else if (m.getTopic() == kTfStatic) {
-      if (const auto msg = m.instantiate<tf2_msgs::TFMessage>()) tf_static.publish(msg);
-    } else if (const auto msg = m.instantiate<tf2_msgs::TFMessage>()) {
-      for (geometry_msgs::TransformStamped& t : msg->transforms)
-        if (!t.header.stamp.isZero()) t.header.stamp = wall(t.header.stamp - ros::Duration(plan.stamp_skew));
-      waitUntil(wall(m.getTime()));
-      tf.publish(msg);
+  for (int pass = 0; clouds < total && ros::ok(); ++pass) {
+    const ros::Duration shift(pass * period);
+    std::size_t in_pass = 0;
+    for (const rosbag::MessageInstance& m : view) {
+      if (!ros::ok()) break;
+      if (m.getTopic() == plan.topic) {
+        if (in_pass >= plan.clouds || clouds >= total) break;
+        const auto msg = m.instantiate<sensor_msgs::PointCloud2>();
+        if (!msg) continue;
+        msg->header.stamp = wall(msg->header.stamp - ros::Duration(plan.stamp_skew) + shift);
+        waitUntil(wall(m.getTime() + shift));
+        points.publish(msg);
+        ++clouds, ++in_pass;
+      } else if (m.getTopic() == kTfStatic) {
+        if (pass > 0) continue;  // latched: once is enough
+        if (const auto msg = m.instantiate<tf2_msgs::TFMessage>()) tf_static.publish(msg);
+      } else if (const auto msg = m.instantiate<tf2_msgs::TFMessage>()) {
+        for (geometry_msgs::TransformStamped& t : msg->transforms)
+          if (!t.header.stamp.isZero()) t.header.stamp = wall(t.header.stamp - ros::Duration(plan.stamp_skew) + shift);
+        waitUntil(wall(m.getTime() + shift));
+        tf.publish(msg);
+      }
     }
+    if (in_pass == 0) break;  // nothing playable: do not spin
   }
   ros::WallDuration(0.5).sleep();  // the last messages leave the publisher's queue
   ros::shutdown();
-  return clouds == plan.clouds ? 0 : 1;
+  return clouds == total ? 0 : 1;
 }
 
 // ---- the manager's side ---------------------------------------------------------------------------------------
@@ -357,7 +373,46 @@ class Recorder {
     if (at.empty()) at.assign(slots_, std::nan(""));
     if (std::isnan(at[slot])) at[slot] = receipt.toSec();
     if (slot == 0 && ++clouds_ == warmup_ + 1) start_ = Usage::now();
+    if (slot == 0 && every_ > 0 && clouds_ % every_ == 0) boundaries_.push_back({clouds_, stamp.toNSec()});
+    if (slot == 0) last_stamp_ = std::max(last_stamp_, stamp.toNSec());
     if (slot + 1 == slots_ && clouds_ > warmup_) end_ = Usage::now();
+  }
+
+  // ---- the soak's windows: bounded bookkeeping, so the manager's own memory does not grow with the run ----
+  // Every `every` clouds, the count and the stamp of that cloud are kept for takeBoundaries().
+  void markEvery(std::size_t every) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    every_ = every;
+  }
+  std::vector<std::pair<std::size_t, std::uint64_t>> takeBoundaries() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return std::exchange(boundaries_, {});
+  }
+  // Clouds seen, and the latest stamp among them (ns).
+  std::pair<std::size_t, std::uint64_t> clouds() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return {clouds_, last_stamp_};
+  }
+  // True when every cloud stamped up to `upto` (ns) has the last stage's output.
+  bool answeredUpTo(std::uint64_t upto) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (auto it = arrivals_.begin(); it != arrivals_.end() && it->first <= upto; ++it)
+      if (!std::isnan(it->second[0]) && std::isnan(it->second[slots_ - 1])) return false;
+    return true;
+  }
+  // Removes the clouds stamped up to `upto` (ns) and returns those after the warm-up, as measured() does. An output
+  // arriving after its cloud was taken out is ignored later (no cloud of its own).
+  std::vector<std::pair<double, std::vector<double>>> drain(std::uint64_t upto) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::vector<std::pair<double, std::vector<double>>> out;
+    auto it = arrivals_.begin();
+    for (; it != arrivals_.end() && it->first <= upto; ++it) {
+      if (std::isnan(it->second[0])) continue;
+      if (drained_++ < warmup_) continue;
+      out.emplace_back(ros::Time().fromNSec(it->first).toSec(), it->second);
+    }
+    arrivals_.erase(arrivals_.begin(), it);
+    return out;
   }
   // Clouds seen, and how many of them have the last stage's output.
   std::pair<std::size_t, std::size_t> progress() const {
@@ -398,6 +453,9 @@ class Recorder {
   mutable std::mutex mutex_;
   std::size_t slots_, warmup_, clouds_ = 0;
   std::map<std::uint64_t, std::vector<double>> arrivals_;
+  std::size_t every_ = 0, drained_ = 0;
+  std::uint64_t last_stamp_ = 0;
+  std::vector<std::pair<std::size_t, std::uint64_t>> boundaries_;  // (clouds seen, stamp) every `every_` clouds
   Usage start_, end_;
 };
 
@@ -476,12 +534,262 @@ class DiagnosticsRecorder {
   std::map<std::string, std::pair<double, std::map<std::string, std::string>>> last_;
 };
 
+// ---- the soak (--loop-frames) ---------------------------------------------------------------------------------
+
+// What /proc says about this process, the one hosting the nodelets.
+struct ProcessSample {
+  double wall_s = 0, cpu_s = 0;  // wall clock and CPU seconds used so far
+  double rss_mb = 0;             // VmRSS
+  int fds = 0, threads = 0;      // entries of /proc/self/fd, Threads
+  double machine_load = 0;       // the machine's 1-minute load average: what the latencies of a shared host follow
+};
+
+ProcessSample sampleThisProcess() {
+  ProcessSample p;
+  p.wall_s = ros::WallTime::now().toSec();
+  p.cpu_s = cpuSecondsOfThisProcess();
+  std::ifstream status("/proc/self/status");
+  for (std::string line; std::getline(status, line);) {
+    std::istringstream in(line);
+    std::string key;
+    in >> key;
+    if (key == "VmRSS:") {
+      double kb = 0;
+      in >> kb;
+      p.rss_mb = kb / 1024.0;
+    } else if (key == "Threads:") {
+      in >> p.threads;
+    }
+  }
+  std::ifstream("/proc/loadavg") >> p.machine_load;
+  std::error_code ec;
+  for (fs::directory_iterator it("/proc/self/fd", ec), end; !ec && it != end; it.increment(ec)) ++p.fds;
+  return p;
+}
+
+struct SoakWindow {
+  std::size_t frame = 0;  // clouds played when the sample was taken
+  ProcessSample process;
+  std::vector<double> end_to_end_ms, base_ms;  // per answered cloud since the previous sample (after the warm-up)
+  std::size_t measured = 0, answered = 0;      // clouds after the warm-up in the window, those with an output
+  double cpu_cores = 0;                        // CPU seconds per wall second since the previous sample
+};
+
+// Samples the process when every `every`-th cloud arrives, and takes that window's clouds out of the recorder once
+// they are answered (or `settle_s` after the sample: a skipped cloud never is), so the bench holds at most a few
+// windows of clouds however long it runs. Prints a line per window.
+class Soak {
+ public:
+  Soak(Recorder* recorder, std::size_t every, double settle_s) : recorder_(recorder), settle_s_(settle_s) {
+    recorder_->markEvery(every);
+  }
+  void begin() {
+    SoakWindow w;
+    w.process = sampleThisProcess();
+    windows_.push_back(std::move(w));
+    print(windows_.back());
+  }
+  // The player has ended: the clouds after the last sample form a last, shorter window.
+  void end() {
+    poll();
+    const auto [clouds, stamp] = recorder_->clouds();
+    const std::size_t last = pending_.empty() ? windows_.back().frame : pending_.back().window.frame;
+    if (clouds > last) add(clouds, stamp);
+  }
+  void poll() {
+    for (const auto& [clouds, stamp] : recorder_->takeBoundaries()) add(clouds, stamp);
+    const double now = ros::WallTime::now().toSec();
+    while (!pending_.empty() &&
+           (recorder_->answeredUpTo(pending_.front().upto) || now - pending_.front().window.process.wall_s > settle_s_)) {
+      Pending& p = pending_.front();
+      for (const auto& [stamp, at] : recorder_->drain(p.upto)) {
+        ++p.window.measured;
+        if (std::isnan(at.back())) continue;
+        ++p.window.answered;
+        p.window.end_to_end_ms.push_back(1e3 * (at.back() - stamp));
+        if (!std::isnan(at[1])) p.window.base_ms.push_back(1e3 * (at[1] - at[0]));
+      }
+      const ProcessSample& before = windows_.back().process;
+      const double wall = p.window.process.wall_s - before.wall_s;
+      p.window.cpu_cores = wall > 0 ? (p.window.process.cpu_s - before.cpu_s) / wall : 0;
+      windows_.push_back(std::move(p.window));
+      pending_.pop_front();
+      print(windows_.back());
+    }
+  }
+  bool idle() const { return pending_.empty(); }
+  const std::vector<SoakWindow>& windows() const { return windows_; }
+
+ private:
+  struct Pending {
+    SoakWindow window;
+    std::uint64_t upto;  // the stamp of the window's last cloud (ns)
+  };
+  void add(std::size_t clouds, std::uint64_t stamp) {
+    Pending p{{}, stamp};
+    p.window.frame = clouds;
+    p.window.process = sampleThisProcess();
+    pending_.push_back(std::move(p));
+  }
+  static void print(const SoakWindow& w) {
+    std::cout << std::fixed << std::setprecision(1) << "soak: frame " << std::setw(6) << w.frame << "  RSS "
+              << std::setw(7) << w.process.rss_mb << " MB  fds " << std::setw(3) << w.process.fds << "  threads "
+              << std::setw(3) << w.process.threads;
+    if (w.frame > 0)
+      std::cout << "  end-to-end p50/p95/max " << percentile(w.end_to_end_ms, 50) << " / "
+                << percentile(w.end_to_end_ms, 95) << " / "
+                << (w.end_to_end_ms.empty() ? 0.0 : *std::max_element(w.end_to_end_ms.begin(), w.end_to_end_ms.end()))
+                << " ms  detector p50/p95 " << percentile(w.base_ms, 50) << " / " << percentile(w.base_ms, 95)
+                << " ms  answered " << w.answered << "/" << w.measured << std::setprecision(2) << "  CPU "
+                << w.cpu_cores << " cores  machine load " << w.process.machine_load;
+    std::cout << std::endl;
+  }
+
+  Recorder* recorder_;
+  double settle_s_;
+  std::deque<Pending> pending_;
+  std::vector<SoakWindow> windows_;  // windows_[0]: the sample before the first cloud
+};
+
+// The acceptance checks over the windows, printed, and the JSON and the table for the plot (scripts/soak.sh) written.
+// The reference is frame K = 1000 (less on a run shorter than 2000 frames: half the run, in whole windows):
+// resident memory from frame K to the end grows by less than 5 %; the descriptor count at the end equals frame K's;
+// the end-to-end p95 of the last K frames is at most 10 % above that of the first K.
+void reportSoak(const std::vector<SoakWindow>& windows, const NodeletBenchOptions& o, double rate_hz,
+                const std::string& last_output) {
+  const std::size_t frames = windows.back().frame, every = static_cast<std::size_t>(o.soak_every);
+  const std::size_t k = std::min<std::size_t>(1000, frames / 2 / every * every);
+  const SoakWindow* ref = nullptr;
+  // End-to-end latencies of the windows within the first and the last K frames (with a partial last window, the
+  // windows starting at or after frame `frames - K`).
+  std::vector<double> first, last;
+  std::size_t measured = 0, answered = 0;
+  for (const SoakWindow& w : windows) {
+    if (w.frame == k) ref = &w;
+    if (w.frame > 0 && w.frame <= k) first.insert(first.end(), w.end_to_end_ms.begin(), w.end_to_end_ms.end());
+    if (w.frame > k && w.frame >= frames - k + every) last.insert(last.end(), w.end_to_end_ms.begin(), w.end_to_end_ms.end());
+    measured += w.measured, answered += w.answered;
+  }
+  const SoakWindow& end = windows.back();
+  const bool checks = ref != nullptr && k > 0;
+  const double rss_growth = checks ? 100.0 * (end.process.rss_mb - ref->process.rss_mb) / ref->process.rss_mb : 0;
+  const double p95_first = percentile(first, 95), p95_last = percentile(last, 95);
+  const double p95_change = p95_first > 0 ? 100.0 * (p95_last - p95_first) / p95_first : 0;
+  const bool rss_ok = checks && rss_growth < 5.0, fds_ok = checks && end.process.fds == ref->process.fds;
+  const bool p95_ok = checks && !first.empty() && !last.empty() && p95_change <= 10.0;
+  int min_fds = end.process.fds, max_fds = end.process.fds;
+  double max_rss = 0;
+  for (const SoakWindow& w : windows)
+    if (w.frame > 0) {
+      min_fds = std::min(min_fds, w.process.fds), max_fds = std::max(max_fds, w.process.fds);
+      max_rss = std::max(max_rss, w.process.rss_mb);
+    }
+
+  std::cout << std::fixed << std::setprecision(1) << "soak: " << frames << " frames at " << rate_hz << " Hz, "
+            << answered << " of " << measured << " measured clouds answered on " << last_output << " ("
+            << measured - answered << " skipped by the latest-frame policy or late)";
+  if (o.load > 0) std::cout << ", " << o.load << " cores kept busy (--load)";
+  std::cout << "\n";
+  if (!checks) {
+    std::cout << "soak: too short for the checks (they need two windows of --soak-every " << every
+              << " frames before and after a reference frame)\n";
+  } else {
+    auto verdict = [](bool ok) { return ok ? "PASS" : "FAIL"; };
+    std::cout << std::setprecision(1) << "soak check: resident memory frame " << k << " -> " << frames << ": "
+              << ref->process.rss_mb << " -> " << end.process.rss_mb << " MB (" << std::showpos << rss_growth
+              << std::noshowpos << " %, limit < +5 %; peak " << max_rss << " MB)  " << verdict(rss_ok) << "\n"
+              << "soak check: open file descriptors frame " << k << " -> " << frames << ": " << ref->process.fds
+              << " -> " << end.process.fds << " (range " << min_fds << "-" << max_fds << " over the run)  "
+              << verdict(fds_ok) << "\n"
+              << "soak check: end-to-end p95 first " << k << " frames " << p95_first << " ms, last " << k
+              << " frames " << p95_last << " ms (" << std::showpos << p95_change << std::noshowpos
+              << " %, limit +10 %)  " << verdict(p95_ok) << "\n"
+              << "soak: " << (rss_ok && fds_ok && p95_ok ? "all checks pass" : "CHECKS FAILED") << "\n";
+  }
+
+  if (o.json.empty()) return;
+  if (fs::path(o.json).has_parent_path()) fs::create_directories(fs::path(o.json).parent_path());
+  std::ostringstream json, table;
+  json << std::fixed << std::setprecision(3) << "{\"frames\": " << frames << ", \"every\": " << every
+       << ", \"rate_hz\": " << rate_hz << ", \"load\": " << o.load << ", \"warmup\": " << o.warmup
+       << ", \"measured\": " << measured << ", \"answered\": " << answered << ", \"samples\": [";
+  table << "# frame\twall_s\trss_mb\tfds\tthreads\tcpu_cores\te2e_p50_ms\te2e_p95_ms\te2e_max_ms\tdetector_p50_ms\t"
+           "detector_p95_ms\tanswered\tmeasured\tmachine_load\n"
+        << std::fixed << std::setprecision(3);
+  for (std::size_t i = 0; i < windows.size(); ++i) {
+    const SoakWindow& w = windows[i];
+    const double max = w.end_to_end_ms.empty() ? 0.0 : *std::max_element(w.end_to_end_ms.begin(), w.end_to_end_ms.end());
+    const double t = w.process.wall_s - windows.front().process.wall_s;
+    json << (i ? ", " : "") << "{\"frame\": " << w.frame << ", \"wall_s\": " << t << ", \"rss_mb\": "
+         << w.process.rss_mb << ", \"fds\": " << w.process.fds << ", \"threads\": " << w.process.threads
+         << ", \"machine_load\": " << w.process.machine_load;
+    if (w.frame > 0)
+      json << ", \"cpu_cores\": " << w.cpu_cores << ", \"end_to_end_p50_ms\": " << percentile(w.end_to_end_ms, 50)
+           << ", \"end_to_end_p95_ms\": " << percentile(w.end_to_end_ms, 95) << ", \"end_to_end_max_ms\": " << max
+           << ", \"detector_p50_ms\": " << percentile(w.base_ms, 50)
+           << ", \"detector_p95_ms\": " << percentile(w.base_ms, 95) << ", \"answered\": " << w.answered
+           << ", \"measured\": " << w.measured;
+    json << "}";
+    if (w.frame > 0)
+      table << w.frame << "\t" << t << "\t" << w.process.rss_mb << "\t" << w.process.fds << "\t" << w.process.threads
+            << "\t" << w.cpu_cores << "\t" << percentile(w.end_to_end_ms, 50) << "\t"
+            << percentile(w.end_to_end_ms, 95) << "\t" << max << "\t" << percentile(w.base_ms, 50) << "\t"
+            << percentile(w.base_ms, 95) << "\t" << w.answered << "\t" << w.measured << "\t"
+            << w.process.machine_load << "\n";
+  }
+  json << "]";
+  if (checks)
+    json << ", \"checks\": {\"reference_frame\": " << k << ", \"rss_reference_mb\": " << ref->process.rss_mb
+         << ", \"rss_end_mb\": " << end.process.rss_mb << ", \"rss_growth_percent\": " << rss_growth
+         << ", \"fds_reference\": " << ref->process.fds << ", \"fds_end\": " << end.process.fds
+         << ", \"p95_first_ms\": " << p95_first << ", \"p95_last_ms\": " << p95_last
+         << ", \"p95_change_percent\": " << p95_change << ", \"rss_ok\": " << (rss_ok ? "true" : "false")
+         << ", \"fds_ok\": " << (fds_ok ? "true" : "false") << ", \"p95_ok\": " << (p95_ok ? "true" : "false")
+         << ", \"passed\": " << (rss_ok && fds_ok && p95_ok ? "true" : "false") << "}";
+  json << "}\n";
+  std::ofstream(o.json) << json.str();
+  const std::string tsv = fs::path(o.json).replace_extension(".tsv").string();
+  std::ofstream(tsv) << table.str();
+  std::cout << "bench: wrote " << o.json << " and " << tsv << "\n";
+}
+
+
 }  // namespace
 
-int runNodeletBench(const NodeletBenchOptions& o) {
+BusyLoad::BusyLoad(int processes) {
+  const pid_t parent = getpid();
+  for (int i = 0; i < processes; ++i) {
+    const pid_t pid = fork();
+    if (pid < 0) {
+      const std::string error = std::strerror(errno);
+      for (const int started : pids_) kill(started, SIGKILL), waitpid(started, nullptr, 0);
+      throw std::runtime_error("--load: fork: " + error);
+    }
+    if (pid == 0) {
+      // Only async-signal-safe calls here: the parent may have threads holding locks.
+      prctl(PR_SET_PDEATHSIG, SIGKILL);
+      if (getppid() != parent) _exit(0);
+      for (volatile std::uint64_t spin = 0;; spin = spin + 1) {
+      }
+    }
+    pids_.push_back(pid);
+  }
+}
+
+BusyLoad::~BusyLoad() {
+  for (const int pid : pids_) kill(pid, SIGKILL);
+  for (const int pid : pids_) waitpid(pid, nullptr, 0);
+  pids_.clear();
+}
+
+int runNodeletBench(const NodeletBenchOptions& o, NodeletBenchResult* result) {
   if (o.stages.empty() || o.stages.front() != "base")
     throw std::runtime_error("--stages must start with base: the nodelets are fed point clouds");
   if (o.rate <= 0) throw std::runtime_error("--rate must be > 0, not " + std::to_string(o.rate));
+  if (o.loop_frames < 0) throw std::runtime_error("--loop-frames must be >= 0, not " + std::to_string(o.loop_frames));
+  if (o.soak_every <= 0) throw std::runtime_error("--soak-every must be > 0, not " + std::to_string(o.soak_every));
+  if (o.load < 0) throw std::runtime_error("--load must be >= 0, not " + std::to_string(o.load));
+  const bool soak = o.loop_frames > 0;
   auto has = [&](const char* s) { return std::find(o.stages.begin(), o.stages.end(), s) != o.stages.end(); };
   const bool intra = has("intra"), inter = has("inter"), tracker = has("track") || inter;
   std::vector<Stage> stages = {{"base", "ret3d_detector", "ret3d/DetectorNodelet", kPoints, "/detections"}};
@@ -544,6 +852,7 @@ int runNodeletBench(const NodeletBenchOptions& o) {
   std::size_t frames = 0, frames_out = 0;
   Recorder::Cpu cpu;
   double player_cpu = 0;
+  std::vector<SoakWindow> soak_windows;
   {
     ros::NodeHandle nh, private_nh("~");
     loadParams(params);
@@ -590,6 +899,8 @@ int runNodeletBench(const NodeletBenchOptions& o) {
     subscribers.push_back(nh.subscribe("/diagnostics", 100, &DiagnosticsRecorder::onMessage, &diagnostics));
     ros::AsyncSpinner spinner(2);
     spinner.start();
+    std::optional<Soak> soak_log;
+    if (soak) soak_log.emplace(&recorder, static_cast<std::size_t>(o.soak_every), std::max(2.0, o.tail));
 
     std::cout << "bench: playing " << plan.clouds << " clouds of " << o.bag << " " << plan.topic << " at "
               << std::setprecision(1) << std::fixed << plan.cloud_rate_hz * o.rate << " Hz"
@@ -597,8 +908,21 @@ int runNodeletBench(const NodeletBenchOptions& o) {
               << " from a player process, stamps moved to now" << (plan.tf ? ", with /tf" : ", no /tf in the bag")
               << (plan.tf_static ? " and /tf_static" : "") << "; " << o.warmup << " warm-up frames left out\n"
               << std::flush;
+    if (soak)
+      std::cout << "bench: soak: the bag looped for " << o.loop_frames << " clouds; this process (pid " << getpid()
+                << ") sampled every " << o.soak_every << " clouds" << std::endl;
+    // The other work starts with the replay, after the nodelets have loaded and warmed up.
+    std::optional<BusyLoad> busy;
+    if (o.load > 0) {
+      busy.emplace(o.load);
+      std::cout << "bench: " << o.load << " busy process" << (o.load > 1 ? "es" : "") << " spinning (--load) during "
+                << "the replay" << std::endl;
+    }
+    if (soak) soak_log->begin();
     if (write(go_fd.fd, "g", 1) != 1) throw std::runtime_error("the player process is gone");
-    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(plan.duration / o.rate + 30.0 + o.tail);
+    const double played_s = (soak ? static_cast<double>(o.loop_frames) / std::max(1e-9, plan.cloud_rate_hz)
+                                  : plan.duration) / o.rate;
+    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(played_s + 30.0 + o.tail);
     ros::WallTime played;
     bool player_done = false;
     while (ros::ok()) {
@@ -609,8 +933,12 @@ int runNodeletBench(const NodeletBenchOptions& o) {
         if (player.exitCode() != 0)
           throw std::runtime_error("the player process failed (exit code " + std::to_string(player.exitCode()) +
                                    "); see its message above");
+        if (soak) soak_log->end();
       }
-      if (player_done) {
+      if (soak) {
+        soak_log->poll();
+        if (player_done && soak_log->idle()) break;
+      } else if (player_done) {
         const auto [in, out] = recorder.progress();
         if (in == out || (now - played).toSec() > o.tail) break;
       }
@@ -621,12 +949,14 @@ int runNodeletBench(const NodeletBenchOptions& o) {
       ros::WallDuration(0.02).sleep();
     }
     if (!ros::ok()) throw std::runtime_error("interrupted");
+    busy.reset();
     // The nodelets report once a second: one more report of each covers the last frames.
     std::vector<std::string> nodelets;
     for (const Stage& s : stages) nodelets.push_back(s.nodelet);
     const double ended = ros::WallTime::now().toSec();
-    for (int i = 0; i < 150 && ros::ok() && !diagnostics.reportedSince(nodelets, ended); ++i)
+    for (int i = 0; i < 150 && ros::ok() && !soak && !diagnostics.reportedSince(nodelets, ended); ++i)
       ros::WallDuration(0.01).sleep();
+    if (soak) soak_windows = soak_log->windows();
     spinner.stop();
     subscribers.clear();
     loader.clear();
@@ -657,9 +987,20 @@ int runNodeletBench(const NodeletBenchOptions& o) {
   }
   ros::shutdown();
   master.stop(SIGINT);
+  if (soak) {
+    reportSoak(soak_windows, o, plan.cloud_rate_hz * o.rate, stages.back().output);
+    return 0;
+  }
 
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
   const std::size_t dropped = frames - frames_out;
+  if (result) {
+    result->base_p50 = percentile(rows.front().ms, 50), result->base_p95 = percentile(rows.front().ms, 95);
+    result->base_processing_p50 = rows.front().processing_p50;
+    result->base_processing_p95 = rows.front().processing_p95;
+    result->end_to_end_p50 = percentile(end_to_end.ms, 50), result->end_to_end_p95 = percentile(end_to_end.ms, 95);
+    result->frames = frames, result->dropped = dropped;
+  }
   std::cout << std::left << std::setw(12) << "stage" << std::right << std::setw(10) << "p50 ms" << std::setw(10)
             << "p95 ms" << std::setw(13) << "out/in" << std::setw(16) << "processing ms" << "\n";
   printRow(input, frames);

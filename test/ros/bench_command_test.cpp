@@ -131,5 +131,80 @@ TEST_F(BenchCommand, MissingBagOrModelIsAClearError) {
   EXPECT_NE(short_bag.output.find("warm-up"), std::string::npos) << short_bag.output;
 }
 
+TEST_F(BenchCommand, SoakLoopsTheBagAndSamplesMemoryDescriptorsAndLatencyPerWindow) {
+  const std::string json = tmp_ / "soak/soak.json";
+  // 30 clouds from a bag of 12: the loop plays it two and a half times, the stamps always increasing.
+  const CommandResult r = bench({"--bag", bag(), "--rate", "0.5", "--warmup", "2", "--loop-frames", "30",
+                                 "--soak-every", "10", "--json", json});
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  ASSERT_TRUE(std::filesystem::exists(json)) << r.output;
+  EXPECT_TRUE(std::filesystem::exists(tmp_ / "soak/soak.tsv")) << r.output;
+  const YAML::Node j = YAML::LoadFile(json);
+  EXPECT_EQ(j["frames"].as<int>(), 30) << r.output;
+  const YAML::Node samples = j["samples"];
+  ASSERT_EQ(samples.size(), 4u) << r.output;  // before the first cloud, then every 10 clouds
+  int measured = 0;
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    EXPECT_EQ(samples[i]["frame"].as<int>(), static_cast<int>(10 * i));
+    EXPECT_GT(samples[i]["rss_mb"].as<double>(), 10.0);  // libtorch and the models are resident
+    EXPECT_GT(samples[i]["fds"].as<int>(), 2);
+    EXPECT_GT(samples[i]["threads"].as<int>(), 1);
+    if (i == 0) continue;
+    measured += samples[i]["measured"].as<int>();
+    EXPECT_LE(samples[i]["answered"].as<int>(), samples[i]["measured"].as<int>());
+    EXPECT_GE(samples[i]["end_to_end_p95_ms"].as<double>(), samples[i]["end_to_end_p50_ms"].as<double>());
+  }
+  // Every cloud played is in exactly one window; the warm-up's are left out of the latencies.
+  EXPECT_EQ(measured, 30 - 2) << r.output;
+  EXPECT_EQ(j["measured"].as<int>(), measured);
+  // A 30-frame run: the reference frame is half the run in whole windows.
+  ASSERT_TRUE(j["checks"]) << r.output;
+  EXPECT_EQ(j["checks"]["reference_frame"].as<int>(), 10);
+  EXPECT_NE(r.output.find("soak check: resident memory frame 10 -> 30"), std::string::npos) << r.output;
+}
+
+TEST_F(BenchCommand, BaselineInProcessTimesBothPipelinesAndPrintsTheRatio) {
+  const std::string json = tmp_ / "bench.json";
+  // The same models as their own baseline, under one busy process: the ratio's plumbing, not its value.
+  const CommandResult r = bench({"--data", tmp_.path(), "--stages", "base", "--warmup", "1", "--min-runs", "3",
+                                 "--baseline", tmp_.path(), "--baseline-detector-config", tmp_ / "detector.yaml",
+                                 "--load", "1", "--json", json});
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("1 busy processes spinning (--load)"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("new / baseline, interleaved frame by frame"), std::string::npos) << r.output;
+  const YAML::Node j = YAML::LoadFile(json);
+  EXPECT_GT(j["baseline_base"]["median_ms"].as<double>(), 0.0) << r.output;
+  EXPECT_GT(j["base_ratio_median"].as<double>(), 0.0) << r.output;
+  EXPECT_GT(j["base_ratio_p95"].as<double>(), 0.0) << r.output;
+}
+
+TEST_F(BenchCommand, SoakLoadAndBaselineOptionsAreCheckedBeforeAnyRun) {
+  struct Case {
+    std::vector<std::string> args;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {{"--data", tmp_.path(), "--loop-frames", "100"}, "--loop-frames (the soak) plays a bag through the nodelets"},
+      {{"--bag", bag(), "--in-process", "--loop-frames", "100"}, "--loop-frames (the soak) plays a bag"},
+      {{"--bag", bag(), "--loop-frames", "-3"}, "--loop-frames must be >= 0"},
+      {{"--bag", bag(), "--loop-frames", "100", "--soak-every", "0"}, "--soak-every must be > 0"},
+      {{"--bag", bag(), "--load", "-1"}, "--load must be >= 0"},
+      {{"--bag", bag(), "--baseline", tmp_ / "nowhere"}, "nowhere: no such folder"},
+      {{"--bag", bag(), "--baseline", tmp_.path(), "--loop-frames", "100"}, "--baseline and --loop-frames"},
+      {{"--stages", "track", "--baseline", tmp_.path()}, "--baseline compares detectors"},
+  };
+  for (const Case& c : cases) {
+    const CommandResult r = bench(c.args);
+    EXPECT_NE(r.exit_code, 0) << c.message;
+    EXPECT_NE(r.output.find(c.message), std::string::npos) << "expected: " << c.message << "\n" << r.output;
+    EXPECT_EQ(r.output.find("private ROS master"), std::string::npos) << "started a run: " << r.output;
+  }
+  // A folder without a detector is no baseline.
+  std::filesystem::create_directories(tmp_ / "empty");
+  const CommandResult r = bench({"--data", tmp_.path(), "--stages", "base", "--baseline", tmp_ / "empty"});
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("no detector.pt there"), std::string::npos) << r.output;
+}
+
 }  // namespace
 }  // namespace ret3d
