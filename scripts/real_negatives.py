@@ -10,10 +10,12 @@ label_2, one file per scan, for `ret3d train detector --data ROOT --labels-cover
   left out: its place is taught as background, which is what the detector gets wrong on real scans;
 - every other box becomes a DontCare box (grown by --grow m): it may be a real object the detector half sees, and
   an unlabelled object must not be taught as background (the training masks DontCare boxes);
-- nothing is written as an object: objects come from the simulated folders trained beside, and from ground-truth
-  sampling, which pastes them into these real scenes.
+- objects: only cars the detector is sure of (score >= --car-score, at least --car-points returns inside; their
+  heading fitted to the returns' outline by the detector's point refinement) are written as Car, the rest of the
+  objects come from the simulated folders trained beside, and from ground-truth sampling, which pastes them into
+  these real scenes.
 
-Usage: scripts/real_negatives.py ROOT PRED [--grow 0.3] [--min-score 0.1]
+Usage: scripts/real_negatives.py ROOT PRED [--grow 0.3] [--min-score 0.1] [--car-score 1.1] [--car-points 30]
 Prints how many boxes per class became background and DontCare.
 """
 import argparse
@@ -61,6 +63,14 @@ def local_frame(pts, x, y, yaw):
     return c * dx + s * dy, -s * dx + c * dy
 
 
+def returns_in(pts, b):
+    """Returns inside the box from 0.3 m above its bottom (the ground left out)."""
+    cls, score, x, y, zb, l, w, h, yaw = b
+    near = pts[(np.abs(pts[:, 0] - x) < l) & (np.abs(pts[:, 1] - y) < l)]
+    u, v = local_frame(near, x, y, yaw)
+    return int(((np.abs(u) <= l / 2) & (np.abs(v) <= w / 2) & (near[:, 2] > zb + 0.3) & (near[:, 2] < zb + h)).sum())
+
+
 def embedded_in_structure(pts, b):
     """True when a small-object box stands in a wall, hedge or under a tree rather than in free space."""
     cls, score, x, y, zb, l, w, h, yaw = b
@@ -89,6 +99,8 @@ def main():
     ap.add_argument("--grow", type=float, default=0.3)
     ap.add_argument("--min-score", type=float, default=0.1,
                     help="boxes scored lower are background too (the detector already calls them so)")
+    ap.add_argument("--car-score", type=float, default=1.1, help="cars scored this or more are labels (default: none)")
+    ap.add_argument("--car-points", type=int, default=30, help="... with at least this many returns in the box")
     ap.add_argument("--debug-out", help="also write the boxes left as background here (KITTI result files)")
     a = ap.parse_args()
     tr = os.path.join(a.root, "training") if os.path.isdir(os.path.join(a.root, "training")) else a.root
@@ -117,9 +129,13 @@ def main():
                     with open(os.path.join(a.debug_out, frame + ".txt"), "a") as f:
                         f.write(raw[frame_boxes.index(b)])
                 continue
-            _, _, x, y, zb, l, w, h, yaw = b
+            _, score, x, y, zb, l, w, h, yaw = b
             c = velo_to_cam @ np.array([x, y, zb, 1.0])
             ry = -yaw - math.pi / 2
+            if cls == "Car" and score >= a.car_score and returns_in(pts, b) >= a.car_points:
+                counts[(cls, "label")] = counts.get((cls, "label"), 0) + 1
+                lines.append("Car 0.00 0 -10 0 0 0 0 %.3f %.3f %.3f %.3f %.3f %.3f %.4f\n" % (h, w, l, c[0], c[1], c[2], ry))
+                continue
             lines.append("DontCare 0.00 0 -10 0 0 0 0 %.3f %.3f %.3f %.3f %.3f %.3f %.4f\n" %
                          (h + 0.2, w + 2 * a.grow, l + 2 * a.grow, c[0], c[1], c[2], ry))
         with open(os.path.join(tr, "label_2", frame + ".txt"), "w") as f:
