@@ -3,7 +3,8 @@
 # the whole gtest + rostest suite through ctest there. Only the package's own code is instrumented
 # (-DRET3D_SANITIZE); libtorch, ROS, Embree and python are not. Any sanitizer report fails the run: the reports
 # are written to build-asan/sanitizer/ and printed at the end.
-# Usage: scripts/sanitize.sh [ctest arguments, e.g. -R ret3d_io_tests]
+# Usage: scripts/sanitize.sh [--no-build] [ctest arguments, e.g. -R ret3d_io_tests]
+#   --no-build: run the tests of the existing build-asan/ as they are (e.g. again after a fix built by hand)
 # Environment: RET3D_SANITIZE_JOBS (build jobs, default 2); RET3D_SANITIZE (-fsanitize= list, default
 # address,undefined,float-cast-overflow: GCC leaves the last out of `undefined`, and a NaN or huge coordinate cast
 # to a grid index is exactly the UB a LiDAR scan can bring).
@@ -15,20 +16,25 @@ SANITIZE=${RET3D_SANITIZE:-address,undefined,float-cast-overflow}
 # Debian's ROS 1 tools need the system python (a pyenv python3 lacks the ROS modules).
 export PATH=/usr/bin:/bin:/usr/sbin:/sbin:$PATH
 
+BUILD_IT=1
+if [[ "${1:-}" == "--no-build" ]]; then BUILD_IT=0; shift; fi
+
 # The Debian packages (scripts/setup.sh installs them; this only checks).
 scripts/setup.sh --no-build
 
 # The normal build's configuration (scripts/setup.sh) plus the sanitizers; -O1 -g (as the sanitizers' manuals
 # advise) keeps the reports' stacks readable, the compile time bearable and the training tests fast enough.
-echo "ret3d sanitize: configuring and building into build-asan/ (-fsanitize=$SANITIZE) ..."
-mkdir -p "$BUILD"
-cmake -S "$ROOT" -B "$BUILD" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g -DNDEBUG" \
-  -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCATKIN_ENABLE_TESTING=ON -DRET3D_SANITIZE="$SANITIZE" \
-  >"$BUILD/build.log" 2>&1 || { cat "$BUILD/build.log"; exit 1; }
-if ! nice -n 5 cmake --build "$BUILD" -j"${RET3D_SANITIZE_JOBS:-2}" --target all tests >>"$BUILD/build.log" 2>&1; then
-  grep -E "error|Error" -A3 "$BUILD/build.log" | head -60 >&2
-  echo "ret3d sanitize: build failed; the full log is in build-asan/build.log" >&2
-  exit 1
+if ((BUILD_IT)); then
+  echo "ret3d sanitize: configuring and building into build-asan/ (-fsanitize=$SANITIZE) ..."
+  mkdir -p "$BUILD"
+  cmake -S "$ROOT" -B "$BUILD" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g -DNDEBUG" \
+    -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCATKIN_ENABLE_TESTING=ON -DRET3D_SANITIZE="$SANITIZE" \
+    >"$BUILD/build.log" 2>&1 || { cat "$BUILD/build.log"; exit 1; }
+  if ! nice -n 5 cmake --build "$BUILD" -j"${RET3D_SANITIZE_JOBS:-2}" --target all tests >>"$BUILD/build.log" 2>&1; then
+    grep -E "error|Error" -A3 "$BUILD/build.log" | head -60 >&2
+    echo "ret3d sanitize: build failed; the full log is in build-asan/build.log" >&2
+    exit 1
+  fi
 fi
 
 # ROS's setup scripts read unset variables: source them without nounset.
