@@ -47,7 +47,7 @@ export ROS_HOME="$BUILD/ros_home"
 export ROS_LOG_DIR="$ROS_HOME/log"
 mkdir -p "$ROS_LOG_DIR"
 
-# Sanitizer reports of every process (the tests, the `ret3d` commands they run, the nodelet manager roslaunch
+# ASan / LSan reports of every process (the tests, the `ret3d` commands they run, the nodelet manager roslaunch
 # starts) go to files here, so a report from a child process whose output a test swallows is still seen.
 REPORTS="$BUILD/sanitizer"
 rm -rf "$REPORTS"
@@ -59,7 +59,7 @@ export ASAN_OPTIONS="halt_on_error=1:abort_on_error=0:detect_leaks=1:detect_stac
 check_initialization_order=1:strict_init_order=1:detect_odr_violation=1:print_suppressions=0:\
 suppressions=$SUPP/asan.supp:log_path=$REPORTS/asan"
 export LSAN_OPTIONS="suppressions=$SUPP/lsan.supp:print_suppressions=0"
-export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1:suppressions=$SUPP/ubsan.supp:log_path=$REPORTS/ubsan"
+export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1:suppressions=$SUPP/ubsan.supp"
 # The nodelet manager (/usr/lib/nodelet/nodelet, not instrumented) loads the instrumented libret3d_nodelets.so: the
 # ASan runtime must be loaded first, so launch/ret3d.launch starts it with this prefix (empty otherwise).
 export RET3D_MANAGER_PREFIX="env LD_PRELOAD=$(g++ -print-file-name=libasan.so)"
@@ -67,12 +67,17 @@ export RET3D_MANAGER_PREFIX="env LD_PRELOAD=$(g++ -print-file-name=libasan.so)"
 echo "ret3d sanitize: running the suite (ASAN_OPTIONS=$ASAN_OPTIONS)"
 cd "$BUILD"
 start=$(date +%s)
-rc=0
-ctest --output-on-failure --timeout 3000 "$@" || rc=$?
+set +e
+ctest --output-on-failure --timeout 3000 "$@" 2>&1 | tee "$REPORTS/ctest.log"
+rc=${PIPESTATUS[0]}
+set -e
 echo "ret3d sanitize: ctest took $(( $(date +%s) - start )) s"
-if compgen -G "$REPORTS/*" >/dev/null; then
-  echo "ret3d sanitize: sanitizer reports:" >&2
-  for f in "$REPORTS"/*; do echo "== $f" >&2; head -80 "$f" >&2; done
+# GCC's UBSan, linked together with ASan, ignores log_path and reports on stderr: those are in the ctest output.
+ubsan=$(grep -c "runtime error:" "$REPORTS/ctest.log" || true)
+if compgen -G "$REPORTS/[al]san*" >/dev/null || ((ubsan)); then
+  echo "ret3d sanitize: sanitizer reports ($ubsan UBSan in build-asan/sanitizer/ctest.log):" >&2
+  grep -h "runtime error:" "$REPORTS/ctest.log" | sort | uniq -c >&2 || true
+  for f in "$REPORTS"/[al]san*; do [[ -e "$f" ]] && { echo "== $f" >&2; head -80 "$f" >&2; }; done
   rc=1
 else
   echo "ret3d sanitize: no sanitizer reports"
