@@ -95,7 +95,9 @@ void accumulateSweep(const PointCloud& cloud, const Eigen::Matrix<float, 3, 4>& 
     }
     if (!(z >= z_min && z <= z_max)) continue;  // also drops NaN
     const float fu = (x - x_min) * inv_res, fv = (y - y_min) * inv_res;
-    if (!(fu >= 0.0f && fv >= 0.0f)) continue;
+    // Bounds in float before the cast: a finite but huge coordinate (1e30) does not fit an int (UB; on x86 it became
+    // INT_MIN, an index far outside the image).
+    if (!(fu >= 0.0f && fv >= 0.0f && fu < static_cast<float>(W) && fv < static_cast<float>(H))) continue;
     const int u = static_cast<int>(fu), v = static_cast<int>(fv);
     if (u >= W || v >= H || v < v_begin || v >= v_end) continue;
     const std::size_t idx = static_cast<std::size_t>(v) * W + u;

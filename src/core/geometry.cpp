@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <unordered_map>
 
 namespace ret3d {
@@ -156,19 +157,23 @@ std::vector<std::uint32_t> countPointsInBoxes(const std::vector<Box>& boxes, con
   // Hash each box into the cells of a 2 m grid its circumscribed circle touches; each point then tests only the
   // boxes of its own cell.
   constexpr double kCell = 2.0;
-  auto key = [](long ix, long iy) { return (static_cast<long long>(ix) << 32) ^ static_cast<unsigned long>(iy); };
-  std::unordered_map<long long, std::vector<std::uint32_t>> grid;
+  // Unsigned shift (a negative cell shifted left is UB before C++20); the cell index clamped before the cast (a
+  // finite 1e30 or a NaN box does not fit an integer). Clamped cells merely share a key: pointInBox decides.
+  auto cell = [](double v) { return static_cast<std::int64_t>(std::fmax(-1e9, std::fmin(1e9, std::floor(v / kCell)))); };
+  auto key = [](std::int64_t ix, std::int64_t iy) {
+    return (static_cast<std::uint64_t>(ix) << 32) ^ static_cast<std::uint32_t>(iy);
+  };
+  std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> grid;
   for (std::uint32_t i = 0; i < boxes.size(); ++i) {
     const Box& b = boxes[i];
     const double r = 0.5 * std::hypot(b.length, b.width);
-    const long x0 = static_cast<long>(std::floor((b.x - r) / kCell)), x1 = static_cast<long>(std::floor((b.x + r) / kCell));
-    const long y0 = static_cast<long>(std::floor((b.y - r) / kCell)), y1 = static_cast<long>(std::floor((b.y + r) / kCell));
-    for (long ix = x0; ix <= x1; ++ix)
-      for (long iy = y0; iy <= y1; ++iy) grid[key(ix, iy)].push_back(i);
+    const std::int64_t x0 = cell(b.x - r), x1 = cell(b.x + r), y0 = cell(b.y - r), y1 = cell(b.y + r);
+    for (std::int64_t ix = x0; ix <= x1; ++ix)
+      for (std::int64_t iy = y0; iy <= y1; ++iy) grid[key(ix, iy)].push_back(i);
   }
   for (const Point& p : cloud.points) {
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) continue;
-    const auto it = grid.find(key(static_cast<long>(std::floor(p.x / kCell)), static_cast<long>(std::floor(p.y / kCell))));
+    const auto it = grid.find(key(cell(p.x), cell(p.y)));
     if (it == grid.end()) continue;
     const Eigen::Vector3d q(p.x, p.y, p.z);
     for (std::uint32_t i : it->second) {

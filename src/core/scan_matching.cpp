@@ -14,19 +14,22 @@ namespace {
 
 using Points = std::vector<Eigen::Vector3d>;
 
-std::int64_t voxelKey(int x, int y, int z) {
+// 21 bits per axis; cellOf keeps each index (and its neighbours) within them, so the shifts never overflow.
+std::uint64_t voxelKey(int x, int y, int z) {
   constexpr std::int64_t kOffset = 1 << 20;
-  return ((x + kOffset) << 42) | ((y + kOffset) << 21) | (z + kOffset);
+  return (static_cast<std::uint64_t>(x + kOffset) << 42) | (static_cast<std::uint64_t>(y + kOffset) << 21) |
+         static_cast<std::uint64_t>(z + kOffset);
 }
 
+// Clamped before the cast: a diverged estimate or a garbage return (1e30) does not fit an int (UB).
 Eigen::Vector3i cellOf(const Eigen::Vector3d& p, double size) {
-  return {static_cast<int>(std::floor(p.x() / size)), static_cast<int>(std::floor(p.y() / size)),
-          static_cast<int>(std::floor(p.z() / size))};
+  auto cell = [size](double v) { return static_cast<int>(std::fmax(-1e6, std::fmin(1e6, std::floor(v / size)))); };
+  return {cell(p.x()), cell(p.y()), cell(p.z())};
 }
 
 // One centroid per voxel of the non-ground points within range.
 Points downsample(const PointCloud& cloud, const ScanMatchingOptions& o) {
-  std::unordered_map<std::int64_t, std::pair<Eigen::Vector3d, int>> cells;
+  std::unordered_map<std::uint64_t, std::pair<Eigen::Vector3d, int>> cells;
   for (const Point& p : cloud.points) {
     if (p.z < o.ground_height || std::hypot(p.x, p.y) > o.max_range) continue;
     const Eigen::Vector3d v(p.x, p.y, p.z);
@@ -86,7 +89,7 @@ class VoxelHash {
  private:
   const Points& points_;
   double radius_;
-  std::unordered_map<std::int64_t, std::vector<std::size_t>> cells_;
+  std::unordered_map<std::uint64_t, std::vector<std::size_t>> cells_;
 };
 
 // The surface normal at each point (the least-variance direction of its neighbours within `radius`); zero where too

@@ -83,8 +83,14 @@ class CellIndex {
   }
 
  private:
-  int cellX(double x) const { return static_cast<int>(std::floor((x - x0_) / cell_)); }
-  int cellY(double y) const { return static_cast<int>(std::floor((y - y0_) / cell_)); }
+  int cellX(double x) const { return clampedCell((x - x0_) / cell_, nx_); }
+  int cellY(double y) const { return clampedCell((y - y0_) / cell_, ny_); }
+  // -1 below the grid (and for NaN), n above it: compared before the cast, as a NaN or huge coordinate does not fit
+  // an int (UB; UBSan on PointRefine.LeavesOtherClassesSparseObjectsAndFarMovesAlone's NaN returns).
+  static int clampedCell(double f, int n) {
+    const double c = std::floor(f);
+    return c >= 0 ? (c < n ? static_cast<int>(c) : n) : -1;
+  }
   double x0_, y0_, cell_;
   int nx_ = 1, ny_ = 1;
   std::vector<std::size_t> start_, order_;

@@ -38,8 +38,12 @@ void ScanStats::add(const PointCloud& cloud, const SensorModel& sensor, const st
     const double h = std::hypot(p.x, p.y), r = std::sqrt(h * h + p.z * p.z);
     if (!std::isfinite(r)) continue;
     ++points;
-    range_hist[std::min<std::size_t>(static_cast<std::size_t>(r), range_hist.size() - 1)] += 1;
-    intensity_hist[std::min<std::size_t>(static_cast<std::size_t>(p.intensity * 50), intensity_hist.size() - 1)] += 1;
+    // Clamped as doubles before the cast: a negative, NaN or huge value does not fit a size_t (UB).
+    auto bin = [](double v, const std::vector<double>& hist) {
+      return static_cast<std::size_t>(std::fmax(0.0, std::fmin(v, static_cast<double>(hist.size() - 1))));
+    };
+    range_hist[bin(r, range_hist)] += 1;
+    intensity_hist[bin(p.intensity * 50.0, intensity_hist)] += 1;
     mean_intensity += p.intensity;
     zero_hist[p.intensity < 1e-3f ? 0 : 1] += 1;
     const double height = p.z + sensor.mount_height;

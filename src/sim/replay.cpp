@@ -42,7 +42,7 @@ ReplayData loadReplay(const std::string& root, const std::string& sequence, cons
       Actor a;
       a.kind = kind;
       a.labelled = kind != ActorKind::Obstacle;
-      a.track_id = static_cast<std::uint32_t>(l.track_id + 1);
+      a.track_id = static_cast<std::uint32_t>(l.track_id) + 1u;  // unsigned: a track id of INT_MAX must not overflow
       drawCar(a, config, rng);  // surfaces (and a body for vehicles)
       a.kind = kind;
       a.length = l.l;

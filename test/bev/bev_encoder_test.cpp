@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 #include <gtest/gtest.h>
 
@@ -100,6 +101,20 @@ TEST(BevEncoder, DensitySaturatesAt64AndOutOfRangePointsAreDropped) {
   for (int i = 0; i < 62; ++i) c62.push_back({0.1f, 0.1f, 0.0f, 0.0f});
   EXPECT_FLOAT_EQ(enc.encode(c63).at(1, 4, 8), 1.0f);
   EXPECT_LT(enc.encode(c62).at(1, 4, 8), 1.0f);
+}
+
+// A corrupt driver or bag can send finite coordinates far beyond any grid: they are dropped, not cast to an int they
+// do not fit (UB that wrote outside the image on x86; caught by scripts/sanitize.sh).
+TEST(BevEncoder, HugeFiniteCoordinatesAreDropped) {
+  BevEncoder enc(smallGrid());
+  const float big = 1e30f, top = std::numeric_limits<float>::max();
+  const PointCloud cur = cloudOf({{big, 0.1f, 0.0f, 0.5f}, {0.1f, big, 0.0f, 0.5f}, {top, top, 0.0f, 0.5f},
+                                  {-big, 0.1f, 0.0f, 0.5f}, {0.1f, 0.1f, 0.0f, 0.5f}});
+  const BevImage img = enc.encode(cur);
+  double total = 0;
+  for (float x : img.data) total += x;
+  EXPECT_FLOAT_EQ(img.at(1, 4, 8), static_cast<float>(std::log(2.0) / std::log(64.0)));  // only the near point
+  EXPECT_NEAR(total, 0.5 + std::log(2.0) / std::log(64.0) + 0.5, 1e-6);
 }
 
 TEST(BevEncoder, PreviousSweepIsMovedIntoTheCurrentFrame) {

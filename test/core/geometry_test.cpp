@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "ret3d/core/transform.h"
@@ -129,6 +130,15 @@ TEST(PointsInBox, GridMatchesBruteForce) {
   for (int i = 0; i < 50000; ++i) cloud.points.push_back({p(rng), p(rng), z(rng), 0});
   const auto counts = countPointsInBoxes(boxes, cloud);
   for (std::size_t i = 0; i < boxes.size(); ++i) EXPECT_EQ(counts[i], countPointsInBox(boxes[i], cloud));
+}
+
+// Garbage points a driver may send (finite but far beyond float's useful range) are simply outside every box.
+TEST(PointsInBox, HugeFiniteCoordinatesAreOutside) {
+  const float big = std::numeric_limits<float>::max();
+  PointCloud cloud;
+  cloud.points = {{big, big, 0, 0}, {-big, 1e30f, 0, 0}, {1e30f, -big, 0, 0}, {-1.5f, -0.5f, 0.5f, 0}};
+  const auto counts = countPointsInBoxes({makeBox(-1.5, -0.5, 0.5, 2, 2, 2, 0.3)}, cloud);
+  EXPECT_EQ(counts[0], 1u);
 }
 
 TEST(Transform, BoxRoundTripAndYaw) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "ret3d/core/transform.h"
@@ -46,6 +47,20 @@ TEST(ScanMatching, RecoversAKnownPlanarMotion) {
   EXPECT_NEAR(m.source_to_target.translation().y(), 0.3, 0.05);
   EXPECT_NEAR(yawOf(m.source_to_target), 3.0 * M_PI / 180.0, 0.3 * M_PI / 180.0);
   EXPECT_LT(m.rmse, 0.3);
+}
+
+// Garbage returns (finite, absurdly far) in either scan are neither cast to an index they do not fit nor matched.
+TEST(ScanMatching, GarbageReturnsAreHarmless) {
+  std::mt19937 rng(11);
+  PointCloud target = scene(&rng);
+  const Eigen::Isometry3d truth = makeTransform(1.2, 0.3, 0.0, 3.0 * M_PI / 180.0);
+  PointCloud source = transformCloud(scene(&rng), truth.inverse());
+  for (PointCloud* c : {&source, &target})
+    for (float z : {1e30f, -1e30f, std::numeric_limits<float>::max()}) c->points.push_back({1.0f, 2.0f, z, 0.5f});
+  const ScanMatch m = matchScans(source, target);
+  ASSERT_TRUE(m.converged);
+  EXPECT_NEAR(m.source_to_target.translation().x(), 1.2, 0.05);
+  EXPECT_NEAR(m.source_to_target.translation().y(), 0.3, 0.05);
 }
 
 TEST(ScanMatching, ReportsFailureWithoutStructure) {

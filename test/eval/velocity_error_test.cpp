@@ -36,7 +36,8 @@ TEST(VelocityError, TheHigherScoreWinsAndUnknownVelocitiesAreSkipped) {
   f.gt = {box(ObjectClass::Car, 0, 10), box(ObjectClass::Car, 30, 10)};
   f.gt_valid = {true, false};
   f.pred = {box(ObjectClass::Car, 0.2, 0, 0.3f), box(ObjectClass::Car, 0.4, 9, 0.8f), box(ObjectClass::Car, 30, 10)};
-  const auto& car = eval::velocityErrors({f}).at(ObjectClass::Car);
+  const auto stats = eval::velocityErrors({f});  // held: a reference into the temporary map dangled (ASan)
+  const auto& car = stats.at(ObjectClass::Car);
   EXPECT_EQ(car.moving_gt, 1u);
   EXPECT_EQ(car.moving_matched, 1u);
   EXPECT_NEAR(car.moving_median, 1.0, 1e-9);

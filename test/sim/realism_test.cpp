@@ -60,6 +60,21 @@ TEST(Realism, CompareReadsTheStatsFilesBack) {
   EXPECT_THROW(compareStats((dir / "a"), (dir / "missing")), std::runtime_error);
 }
 
+// Intensities outside [0, 1] (a driver's raw counts, a negative int8) and absurd ranges land in the edge bins.
+TEST(Realism, OutOfRangeValuesFallInTheEdgeBins) {
+  SensorModel sensor = sensorByName("hdl64e", RET3D_SOURCE_DIR);
+  PointCloud c;
+  c.push_back(Point{5.0f, 0.0f, -1.7f, -3.0f});
+  c.push_back(Point{5.0f, 0.0f, -1.7f, 255.0f});
+  c.push_back(Point{1e30f, 0.0f, -1.7f, 0.5f});
+  ScanStats s;
+  s.add(c, sensor, {});
+  EXPECT_EQ(s.intensity_hist.front(), 1.0);
+  EXPECT_EQ(s.intensity_hist.back(), 1.0);
+  EXPECT_EQ(s.range_hist.back(), 1.0);
+  EXPECT_EQ(s.range_hist[5], 2.0);
+}
+
 // A flat ground plane 1.73 m below the sensor, plus optionally a porous box in front of it.
 TriangleMesh groundScene(float reflectivity, float wall_porosity = -1) {
   TriangleMesh m;
