@@ -7,7 +7,8 @@
 # timeout), 77 when clang or libFuzzer is missing (ctest reports the test as skipped).
 # Usage: scripts/fuzz.sh [SECONDS_PER_TARGET (600)] [TARGET...]
 #   targets: pointcloud2 kitti_io config model_file bag_check (default: all, one after the other)
-# Environment: FUZZ_JOBS build parallelism (2).
+# Environment: FUZZ_JOBS build parallelism (2); FUZZ_SKIP_BUILD=1 uses the targets already in build/fuzz (to run two
+# instances side by side without two builds in one folder).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$(pwd)
@@ -31,16 +32,18 @@ fi
 BUILD="$ROOT/build/fuzz"
 OUT="$ROOT/out/fuzz"
 start=$(date +%s)
-echo "fuzz: building ${TARGETS[*]} into build/fuzz ..."
-mkdir -p "$BUILD"
-if ! { cmake -S "$ROOT/test/fuzz" -B "$BUILD" -DCMAKE_CXX_COMPILER="$CLANG" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-         -DPYTHON_EXECUTABLE=/usr/bin/python3 &&
-       nice -n 5 cmake --build "$BUILD" -j"${FUZZ_JOBS:-2}" --target "${TARGETS[@]/%/_fuzz}"; } >"$BUILD/build.log" 2>&1; then
-  grep -E "error|Error" -A3 "$BUILD/build.log" | head -40 >&2
-  echo "fuzz: build failed; the log is build/fuzz/build.log" >&2
-  exit 1
+if [[ "${FUZZ_SKIP_BUILD:-0}" != 1 ]]; then
+  echo "fuzz: building ${TARGETS[*]} into build/fuzz ..."
+  mkdir -p "$BUILD"
+  if ! { cmake -S "$ROOT/test/fuzz" -B "$BUILD" -DCMAKE_CXX_COMPILER="$CLANG" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+           -DPYTHON_EXECUTABLE=/usr/bin/python3 &&
+         nice -n 5 cmake --build "$BUILD" -j"${FUZZ_JOBS:-2}" --target "${TARGETS[@]/%/_fuzz}"; } >"$BUILD/build.log" 2>&1; then
+    grep -E "error|Error" -A3 "$BUILD/build.log" | head -40 >&2
+    echo "fuzz: build failed; the log is build/fuzz/build.log" >&2
+    exit 1
+  fi
+  echo "fuzz: built in $(($(date +%s) - start)) s"
 fi
-echo "fuzz: built in $(($(date +%s) - start)) s"
 
 # A run's options: the limits make huge allocations and hangs findings, not slowness.
 export OMP_NUM_THREADS=1
@@ -59,10 +62,8 @@ add_seeds() {
       for f in config/sensors/*.yaml; do { printf 5; cat "$f"; } >"$dir/repo_sensor_$(basename "$f")"; done
       ;;
     model_file)
-      # The smallest model of each kind (the fuzzer's speed falls with the input size).
-      for sel in 0 1; do { printf $sel; cat models/lwd3d/detector.pt; } >"$dir/repo_detector_$sel"; done
-      { printf 2; cat models/lwd3d/intra_rm.pt; } >"$dir/repo_intra_rm"
-      { printf 3; cat models/lwd3d/inter_rm.pt; } >"$dir/repo_inter_rm"
+      # The repository models' metadata (and the detector file whole), written by the target itself.
+      RET3D_FUZZ_WRITE_SEEDS="$dir" "$BUILD/model_file_fuzz" -runs=0 "$dir" >/dev/null 2>&1
       ;;
   esac
 }

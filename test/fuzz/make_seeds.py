@@ -156,4 +156,4 @@ out("bag_check", "writer_random", bytes([ord("1")]) + bytes((k * 37 + 11) % 256 
 
 # ---- model_file: scripts/fuzz.sh adds models/**.pt; two small refusals here -------------------------------------------
 out("model_file", "detector_truncated", b"0RET3DMDL" + struct.pack("<IQ", 1, 40) + b"format_version: 1\n")
-out("model_file", "detector_version2", b"1RET3DMDL" + struct.pack("<IQ", 2, 0) + struct.pack("<QQ", 0, 0))
+out("model_file", "detector_version2", b"0RET3DMDL" + struct.pack("<IQ", 2, 0) + struct.pack("<QQ", 0, 0))
