@@ -21,8 +21,8 @@ PACKAGES=(
   python3-rostopic python3-rosnode rosbash ros-message-generation ros-sensor-msgs ros-visualization-msgs
   python3-sensor-msgs python3-geometry-msgs python3-visualization-msgs python3-tf2-msgs
   libdiagnostic-updater-dev libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
-  # checks, plots, visual tests
-  catkin-lint gnuplot-nox imagemagick rviz xvfb
+  # checks, plots, visual tests; clang with libFuzzer for the fuzz targets (scripts/fuzz.sh)
+  catkin-lint gnuplot-nox imagemagick rviz xvfb clang libclang-rt-14-dev
   # model-building scripts (scripts/fit_score_calibration.py)
   python3-numpy
 )

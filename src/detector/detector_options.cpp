@@ -357,8 +357,7 @@ void flatten(const YAML::Node& n, const std::string& prefix, std::map<std::strin
 
 }  // namespace
 
-DetectorOptions detectorOptionsFromYaml(const std::string& yaml_text, const std::string& origin) {
-  const YAML::Node root = parse(yaml_text, origin);
+static DetectorOptions readDetectorOptions(const YAML::Node& root, const std::string& origin) {
   DetectorOptions o;
   MapReader r(root, "", origin);
   readModel(r.child("model"), &o.model);
@@ -376,6 +375,16 @@ DetectorOptions detectorOptionsFromYaml(const std::string& yaml_text, const std:
     throw std::runtime_error(origin + ": inference.grid_extent: " + e.what());
   }
   return o;
+}
+
+// A value of the wrong type (yaml-cpp's BadConversion, e.g. a list where a name belongs) is refused naming the file.
+DetectorOptions detectorOptionsFromYaml(const std::string& yaml_text, const std::string& origin) {
+  const YAML::Node root = parse(yaml_text, origin);
+  try {
+    return readDetectorOptions(root, origin);
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error(origin + ": " + e.what());
+  }
 }
 
 DetectorOptions loadDetectorOptions(const std::string& path) {

@@ -165,6 +165,14 @@ Calibration readCalibration(const std::string& path) {
     const auto it = values.find(pk[k]);
     c.P[k] = it != values.end() ? rows34(it->second) : Eigen::Matrix<double, 3, 4>::Zero();
   }
+  // The package inverts these (camera rays, rectified camera -> LiDAR): a singular one would give NaN boxes and
+  // wedges far from the file, so it is refused here, naming it.
+  const auto invertible = [&](const Eigen::Matrix3d& m, Key k, const char* name) {
+    if (!(std::abs(m.determinant()) >= 1e-12)) detail::fail({path, seen_at[k]}, name, "singular matrix");
+  };
+  invertible(c.P2.leftCols<3>(), Key::P2, "P2");
+  invertible(c.R0_rect, Key::R0_rect, "R0_rect");
+  invertible(c.velo_to_cam.linear(), Key::Tr_velo_to_cam, "Tr_velo_to_cam");
   return c;
 }
 

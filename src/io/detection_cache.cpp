@@ -43,6 +43,15 @@ class Reader {
     return s;
   }
   [[noreturn]] void fail() const { throw std::runtime_error(path_ + ": truncated or corrupt detection cache"); }
+  // Bytes left in the file, so counts read from it are checked before anything is allocated for them.
+  std::uint64_t remaining() {
+    const auto pos = in_.tellg();
+    in_.seekg(0, std::ios::end);
+    const auto end = in_.tellg();
+    in_.seekg(pos);
+    if (pos < 0 || end < pos) fail();
+    return static_cast<std::uint64_t>(end - pos);
+  }
 
  private:
   std::istream& in_;
@@ -103,6 +112,9 @@ bool readDetectionCache(const std::string& path, const std::string& key, Sequenc
     const auto n = r.get<std::uint64_t>();
     const auto dim = r.get<std::uint64_t>();
     if (n > (1u << 24) || dim > (1u << 16)) r.fail();
+    // A damaged count must not allocate gigabytes: the boxes and features it announces have to be in the file.
+    constexpr std::uint64_t kBoxBytes = 9 * sizeof(double) + sizeof(float) + 3 * sizeof(std::uint32_t);
+    if (n * (kBoxBytes + dim * sizeof(float)) > r.remaining()) r.fail();
     Detections d;
     d.feature_dim = dim;
     d.boxes.resize(n);

@@ -1,9 +1,11 @@
 #include "ret3d/io/detections.h"
 
 #include <cerrno>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 namespace ret3d {
@@ -91,9 +93,11 @@ std::vector<kitti::Label> readPerClassCsvDetections(const std::string& path) {
     double v[kCsvFieldCount];
     for (int i = 0; i < kCsvFieldCount; ++i) v[i] = parseNumber(fields[i], path, line_no, kCsvFields[i]);
     kitti::Label l;
-    if (v[0] < 0 || v[0] != static_cast<int>(v[0])) fail(path, line_no, "field 'frame': not a frame index");
+    // Range-checked before the casts: a double beyond int's range does not convert (undefined behaviour).
+    if (!(v[0] >= 0 && v[0] <= std::numeric_limits<int>::max()) || v[0] != std::floor(v[0]))
+      fail(path, line_no, "field 'frame': not a frame index");
     l.frame = static_cast<int>(v[0]);
-    switch (static_cast<int>(v[1])) {
+    switch (v[1] == 1 || v[1] == 2 || v[1] == 3 ? static_cast<int>(v[1]) : 0) {
       case 1:
         l.type = "Pedestrian";
         break;

@@ -38,7 +38,7 @@ class ConfigReader {
   void checkKeys(const YAML::Node& node, const std::set<std::string>& allowed, const std::string& section) const {
     if (!node.IsMap()) fail("'" + section + "' must be a mapping");
     for (const auto& kv : node) {
-      const std::string key = kv.first.as<std::string>();
+      const std::string key = keyName(kv.first, section);
       if (!allowed.count(key)) {
         std::string list;
         for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
@@ -46,6 +46,13 @@ class ConfigReader {
              "; known: " + list + ")");
       }
     }
+  }
+
+  // A mapping key as text; a key that is not a plain scalar (a sequence, a null) fails naming the line.
+  std::string keyName(const YAML::Node& key, const std::string& section) const {
+    if (!key.IsScalar())
+      fail("a key of '" + section + "' (line " + std::to_string(key.Mark().line + 1) + ") is not a plain name");
+    return key.Scalar();
   }
 
   // Leaves *value unchanged when the key is absent.
@@ -68,7 +75,7 @@ class ConfigReader {
     const std::string name = "'" + section + "." + key;
     if (!n.IsMap()) fail(name + "' must map Car/Pedestrian/Cyclist to numbers");
     for (const auto& kv : n) {
-      const std::string cls_name = kv.first.as<std::string>();
+      const std::string cls_name = keyName(kv.first, section + "." + key);
       const auto cls = classFromName(cls_name);
       if (!cls) fail(name + "' has unknown class '" + cls_name + "'");
       try {

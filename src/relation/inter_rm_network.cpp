@@ -196,7 +196,7 @@ namespace {
   throw std::runtime_error("InterRM model " + path + ": " + msg);
 }
 
-InterRMModelInfo parseMetadata(const std::string& path, const std::string& text) {
+InterRMModelInfo parseMetadataFields(const std::string& path, const std::string& text) {
   YAML::Node m;
   try {
     m = YAML::Load(text);
@@ -231,6 +231,15 @@ InterRMModelInfo parseMetadata(const std::string& path, const std::string& text)
     bad(path, err.what());
   }
   return info;
+}
+
+// A value of the wrong type (yaml-cpp's BadConversion) is refused like any other bad metadata, naming the file.
+InterRMModelInfo parseMetadata(const std::string& path, const std::string& text) {
+  try {
+    return parseMetadataFields(path, text);
+  } catch (const YAML::Exception& e) {
+    bad(path, std::string("unreadable metadata: ") + e.what());
+  }
 }
 
 }  // namespace

@@ -188,7 +188,7 @@ std::string shapeString(const std::vector<int64_t>& v) {
 
 }  // namespace
 
-static IntraRMModelInfo parseIntraRMMetadata(const std::string& path, const std::string& text) {
+static IntraRMModelInfo parseIntraRMMetadataFields(const std::string& path, const std::string& text) {
   YAML::Node m;
   try {
     m = YAML::Load(text);
@@ -224,6 +224,15 @@ static IntraRMModelInfo parseIntraRMMetadata(const std::string& path, const std:
     bad(path, err.what());
   }
   return info;
+}
+
+// A value of the wrong type (yaml-cpp's BadConversion) is refused like any other bad metadata, naming the file.
+static IntraRMModelInfo parseIntraRMMetadata(const std::string& path, const std::string& text) {
+  try {
+    return parseIntraRMMetadataFields(path, text);
+  } catch (const YAML::Exception& e) {
+    bad(path, std::string("unreadable metadata: ") + e.what());
+  }
 }
 
 static torch::serialize::InputArchive openArchive(const std::string& path) {

@@ -84,6 +84,14 @@ const char* datatypeName(std::uint8_t datatype) {
   }
 }
 
+// double -> float; values beyond float's range become +-inf (a plain cast of those is undefined behaviour).
+float toFloat(double v) {
+  constexpr double kMax = std::numeric_limits<float>::max();
+  if (v > kMax) return std::numeric_limits<float>::infinity();
+  if (v < -kMax) return -std::numeric_limits<float>::infinity();
+  return static_cast<float>(v);
+}
+
 template <typename T>
 T loadAs(const std::uint8_t* bytes) {
   T v;
@@ -230,19 +238,20 @@ PointCloud toCloud(const sensor_msgs::PointCloud2& msg, const CloudConversionOpt
     for (std::size_t col = 0; col < width; ++col) {
       if (!read(row * width + col)) continue;
       const std::uint8_t* p = row_ptr + col * msg.point_step;
-      const double x = fx->read(p), y = fy->read(p), z = fz->read(p);
-      if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) {
+      // Finiteness is checked after the conversion to float: a float64 coordinate beyond float's range (1e300) is as
+      // unusable as a NaN.
+      Point pt;
+      pt.x = toFloat(fx->read(p));
+      pt.y = toFloat(fy->read(p));
+      pt.z = toFloat(fz->read(p));
+      if (!std::isfinite(pt.x) || !std::isfinite(pt.y) || !std::isfinite(pt.z)) {
         ++rep.dropped_nonfinite;
         continue;
       }
-      Point pt;
-      pt.x = static_cast<float>(x);
-      pt.y = static_cast<float>(y);
-      pt.z = static_cast<float>(z);
       if (fi) {
-        const double v = fi->read(p);
+        const float v = toFloat(fi->read(p));
         // A non-finite intensity is a sensor glitch on a valid point: keep the point, with intensity 0.
-        pt.intensity = std::isfinite(v) ? static_cast<float>(v) : 0.0f;
+        pt.intensity = std::isfinite(v) ? v : 0.0f;
         raw_max = std::max(raw_max, static_cast<double>(pt.intensity));
       }
       cloud.points.push_back(pt);
@@ -276,8 +285,8 @@ PointCloud toCloud(const sensor_msgs::PointCloud2& msg, const CloudConversionOpt
         break;
     }
     rep.intensity_divisor = divisor;
-    const float inv = static_cast<float>(1.0 / divisor);
-    for (auto& pt : cloud.points) pt.intensity = std::clamp(pt.intensity * inv, 0.0f, 1.0f);
+    // Divided in double: 1 / divisor in float overflows for a tiny FixedScale divisor (0 * inf = NaN intensities).
+    for (auto& pt : cloud.points) pt.intensity = static_cast<float>(std::clamp(pt.intensity / divisor, 0.0, 1.0));
   }
 
   if (ftime) {
@@ -291,7 +300,10 @@ PointCloud toCloud(const sensor_msgs::PointCloud2& msg, const CloudConversionOpt
       if (origin == 0.0) origin = *std::min_element(times.begin(), times.end()) * to_seconds;
     }
     cloud.time.resize(times.size());
-    for (std::size_t i = 0; i < times.size(); ++i) cloud.time[i] = static_cast<float>(times[i] * to_seconds - origin);
+    for (std::size_t i = 0; i < times.size(); ++i) {
+      const float t = toFloat(times[i] * to_seconds - origin);
+      cloud.time[i] = std::isfinite(t) ? t : 0.0f;  // like a non-finite raw time: an offset beyond float's range
+    }
   }
   return cloud;
 }

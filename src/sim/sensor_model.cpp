@@ -8,6 +8,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "yaml_file.h"
+
 namespace ret3d {
 namespace sim {
 
@@ -63,13 +65,7 @@ double number(const std::string& file, const YAML::Node& n, const std::string& k
 
 }  // namespace
 
-SensorModel loadSensorModel(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error(path + ": cannot read YAML: " + e.what());
-  }
+static SensorModel readSensorModel(const YAML::Node& root, const std::string& path) {
   if (!root.IsMap()) fail(path, "", "expected a map");
   SensorModel s;
   s.source = path;
@@ -138,6 +134,10 @@ SensorModel loadSensorModel(const std::string& path) {
   // Ring 0 is the lowest beam.
   std::sort(s.elevation_deg.begin(), s.elevation_deg.end());
   return s;
+}
+
+SensorModel loadSensorModel(const std::string& path) {
+  return readYamlFile<SensorModel>(path, readSensorModel);
 }
 
 SensorModel sensorByName(const std::string& name, const std::string& package_root) {

@@ -6,6 +6,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "yaml_file.h"
+
 namespace ret3d {
 namespace sim {
 
@@ -92,13 +94,7 @@ class Reader {
 
 }  // namespace
 
-SimConfig loadSimConfig(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error(path + ": cannot read YAML: " + e.what());
-  }
+static SimConfig readSimConfig(const YAML::Node& root, const std::string& path) {
   SimConfig c;
   c.source = path;
   c.materials = defaultMaterials();
@@ -217,6 +213,10 @@ SimConfig loadSimConfig(const std::string& path) {
   });
   if (t.sedan + t.hatchback + t.suv + t.van <= 0) r.fail("traffic.sedan", "body type mix sums to zero");
   return c;
+}
+
+SimConfig loadSimConfig(const std::string& path) {
+  return readYamlFile<SimConfig>(path, readSimConfig);
 }
 
 }  // namespace sim

@@ -133,7 +133,11 @@ TrackerOptions parseTrackerOptions(const std::string& yaml_text) {
   } catch (const YAML::Exception& e) {
     throw std::runtime_error(std::string("tracker options: YAML parse error: ") + e.what());
   }
-  return fromNode(root);
+  try {
+    return fromNode(root);
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error(std::string("tracker options: ") + e.what());
+  }
 }
 
 TrackerOptions loadTrackerOptions(const std::string& yaml_path) {
@@ -149,6 +153,8 @@ TrackerOptions loadTrackerOptions(const std::string& yaml_path) {
     return fromNode(root);
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument(yaml_path + ": " + e.what());
+  } catch (const YAML::Exception& e) {  // a value of the wrong type, e.g. a list where a name belongs
+    throw std::runtime_error(yaml_path + ": " + e.what());
   }
 }
 

@@ -141,6 +141,26 @@ TEST(Calibration, MalformedValuesNameFileLineAndKey) {
   EXPECT_EQ(test::parseErrorMessage(read), path + ":2: field 'P2': given twice (first at line 1)");
 }
 
+// Found by fuzzing (test/fuzz/regressions/kitti_io): a singular P2 was read, and failed far from the file
+// ("imageRegionWedge: P2 is singular"); a singular R0_rect or Tr_velo_to_cam gave NaN boxes.
+TEST(Calibration, SingularMatricesAreRefusedNamingFileLineAndKey) {
+  TempDir tmp;
+  const std::string path = tmp / "singular.txt";
+  const auto read = [&] { kitti::readCalibration(path); };
+  kitti::Calibration c = kitti::defaultCalibration();
+  c.P2.row(2).setZero();
+  kitti::writeCalibration(path, c);
+  EXPECT_EQ(test::parseErrorMessage(read), path + ":3: field 'P2': singular matrix");
+  c = kitti::defaultCalibration();
+  c.R0_rect.setZero();
+  kitti::writeCalibration(path, c);
+  EXPECT_NE(test::parseErrorMessage(read).find("field 'R0_rect': singular matrix"), std::string::npos);
+  c = kitti::defaultCalibration();
+  c.velo_to_cam.linear().col(0).setZero();
+  kitti::writeCalibration(path, c);
+  EXPECT_NE(test::parseErrorMessage(read).find("field 'Tr_velo_to_cam': singular matrix"), std::string::npos);
+}
+
 TEST(Calibration, VeloToRectAndBackAreInverseAndProjectionIsKitti) {
   const kitti::Calibration c = kitti::defaultCalibration();
   const Eigen::Vector3d p(12.3, -4.5, -0.7);

@@ -79,5 +79,29 @@ TEST(DetectionCache, TruncatedOrForeignFilesAreRefusedNamingTheFile) {
   EXPECT_THROW(io::readDetectionCache(path, "k", &out), std::runtime_error);
 }
 
+// Found by fuzzing (test/fuzz/regressions/kitti_io): a damaged box count or feature size made the reader allocate
+// gigabytes (or throw std::bad_alloc) for a file of a few hundred bytes.
+TEST(DetectionCache, CountsBeyondTheFileAreRefusedBeforeAllocating) {
+  test::TempDir dir;
+  const std::string path = dir.path() + "/d.cache";
+  io::writeDetectionCache(path, "k", sample());
+  // The first entry's box count and feature size: after magic, version, key, entry count, sequence and frame.
+  const std::streamoff count_at = 8 + 4 + (8 + 1) + 8 + (8 + 4) + 4;
+  {
+    std::fstream f(path, std::ios::binary | std::ios::in | std::ios::out);
+    f.seekp(count_at);
+    const std::uint64_t n = 1u << 20, dim = 1u << 16;
+    f.write(reinterpret_cast<const char*>(&n), sizeof(n));
+    f.write(reinterpret_cast<const char*>(&dim), sizeof(dim));
+  }
+  io::SequenceDetections out;
+  try {
+    io::readDetectionCache(path, "k", &out);
+    FAIL() << "a cache announcing more boxes than it holds was read";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace ret3d

@@ -67,6 +67,12 @@ TEST(Detections, BadLinesNameFileLineAndField) {
   } catch (const kitti::ParseError& e) {
     EXPECT_NE(std::string(e.what()).find("'x2'"), std::string::npos) << e.what();
   }
+  // Found by fuzzing (test/fuzz/regressions/kitti_io): a frame or type beyond int's range was cast (undefined
+  // behaviour) instead of refused.
+  write(dir / "Car/0003.txt", "1e68,2,1,2,3,4,0.5,1,2,3,4,5,6,0.1,0.2\n");
+  EXPECT_THROW(readPerClassCsvDetections(dir / "Car/0003.txt"), kitti::ParseError);
+  write(dir / "Car/0004.txt", "0,4294967298,1,2,3,4,0.5,1,2,3,4,5,6,0.1,0.2\n");
+  EXPECT_THROW(readPerClassCsvDetections(dir / "Car/0004.txt"), kitti::ParseError);
 }
 
 TEST(Detections, DetectsKittiResultLayouts) {

@@ -285,6 +285,41 @@ TEST(ToCloud, NonFinitePointsDroppedAndCounted) {
   EXPECT_EQ(cloud.points[56].intensity, 0.0f);  // pts[60] after 4 drops
 }
 
+// Found by fuzzing (test/fuzz/regressions/pointcloud2): float64 values beyond float's range became infinite points
+// (and infinite times) in the core cloud; a tiny FixedScale divisor gave NaN intensities.
+TEST(ToCloud, Float64BeyondFloatRangeIsDroppedLikeNonFinite) {
+  const std::vector<FieldSpec> fields = {{"x", 0, PointField::FLOAT64},
+                                         {"y", 8, PointField::FLOAT64},
+                                         {"z", 16, PointField::FLOAT64},
+                                         {"intensity", 24, PointField::FLOAT64},
+                                         {"time", 32, PointField::FLOAT64}};
+  auto pts = randomPoints(4, 255.0);
+  pts[1]["x"] = 1e300;
+  pts[2]["intensity"] = -1e300;
+  pts[3]["time"] = 1e300;
+  CloudConversionReport report;
+  const PointCloud cloud = toCloud(buildCloud(fields, 40, pts), {}, &report);
+  EXPECT_EQ(report.dropped_nonfinite, 1u);
+  ASSERT_EQ(cloud.size(), 3u);
+  expectIntensityInUnitRange(cloud);
+  EXPECT_EQ(cloud.points[1].intensity, 0.0f);  // pts[2]: kept, its unusable intensity 0
+  for (float t : cloud.time) EXPECT_TRUE(std::isfinite(t)) << t;
+}
+
+TEST(ToCloud, TinyFixedScaleGivesIntensitiesInUnitRange) {
+  const auto fields = xyzAnd({{"intensity", 12, PointField::UINT16}});
+  auto pts = randomPoints(3, 1.0);
+  pts[0]["intensity"] = 0;
+  pts[1]["intensity"] = 7;
+  CloudConversionOptions opt;
+  opt.intensity_scaling = IntensityScaling::FixedScale;
+  opt.intensity_scale = 1e-310;  // 1 / scale overflows
+  const PointCloud cloud = toCloud(buildCloud(fields, 16, pts), opt);
+  expectIntensityInUnitRange(cloud);
+  EXPECT_EQ(cloud.points[0].intensity, 0.0f);
+  EXPECT_EQ(cloud.points[1].intensity, 1.0f);
+}
+
 TEST(ToCloud, BigEndianIsByteSwapped) {
   const auto fields = xyzAnd(
       {{"intensity", 12, PointField::UINT16}, {"ring", 14, PointField::UINT16}, {"time", 16, PointField::FLOAT64}});

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <sstream>
 
@@ -253,6 +254,32 @@ TEST(ConvertCommand, CheckListsTheProblemsOfABrokenBag) {
   const CheckReport in_sensor_frame = checkBag(bag_path, "velodyne");
   EXPECT_FALSE(in_sensor_frame.ok());
   for (const auto& p : in_sensor_frame.problems) EXPECT_EQ(p.find("no transform"), std::string::npos) << p;
+}
+
+// Found by fuzzing (test/fuzz/regressions/bag_check): rosbag allocates what a damaged length field says (gigabytes
+// for a bag of kilobytes) before it notices the damage; --check refuses such a bag up front, naming it.
+TEST(ConvertCommand, CheckRefusesABagWithADamagedLengthFieldNamingIt) {
+  test::TempDir tmp;
+  test::TinySequence seq;
+  seq.write(tmp.path(), "0000", 2, /*with_labels=*/false);
+  const std::string bag_path = tmp / "damaged.bag";
+  const CommandResult conv = run(cli() + " convert " + tmp.path() + "/training " + bag_path);
+  ASSERT_EQ(conv.exit_code, 0) << conv.output;
+  ASSERT_TRUE(checkBag(bag_path).ok());
+  {
+    // The bag header record's header length, right after "#ROSBAG V2.0\n".
+    std::fstream f(bag_path, std::ios::binary | std::ios::in | std::ios::out);
+    f.seekp(13);
+    const std::uint32_t huge = 0xFFFFFF00u;
+    f.write(reinterpret_cast<const char*>(&huge), sizeof(huge));
+  }
+  try {
+    checkBag(bag_path);
+    FAIL() << "a damaged bag was read";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(bag_path), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("damaged"), std::string::npos) << e.what();
+  }
 }
 
 TEST(ConvertCommand, RealUnlabeledScans) {
