@@ -116,9 +116,9 @@ def main():
         pts = np.fromfile(scan, dtype=np.float32).reshape(-1, 4)[:, :3].astype(np.float64)
         lines = []
         pred_file = os.path.join(a.pred, frame + ".txt")
-        raw = open(pred_file).readlines() if os.path.exists(pred_file) else []
-        frame_boxes = read_boxes(pred_file, cam_to_velo)
-        for b in frame_boxes:
+        raw = [l for l in open(pred_file) if len(l.split()) >= 16] if os.path.exists(pred_file) else []
+        frame_boxes = read_boxes(pred_file, cam_to_velo)  # one per line of raw, in order
+        for line, b in zip(raw, frame_boxes):
             cls = b[0]
             background = b[1] < a.min_score or (cls in ("Pedestrian", "Cyclist") and embedded_in_structure(pts, b))
             key = (cls, "background" if background else "DontCare")
@@ -127,7 +127,7 @@ def main():
                 if a.debug_out:
                     os.makedirs(a.debug_out, exist_ok=True)
                     with open(os.path.join(a.debug_out, frame + ".txt"), "a") as f:
-                        f.write(raw[frame_boxes.index(b)])
+                        f.write(line)
                 continue
             _, score, x, y, zb, l, w, h, yaw = b
             c = velo_to_cam @ np.array([x, y, zb, 1.0])
