@@ -5,7 +5,10 @@
 #   (scripts/eval_heldout.sh: urban seeds 9000-9004, 500 frames), prints one row per configuration and writes the
 #   table between the intra-sim-ablation markers of docs/RESULTS.md.
 #   scripts/ablate_intra_sim.sh [CONFIGS...]     (default: all; two trainings at a time, one thread each)
-# Work files: out/ablate_intra_sim/. Needs models/lwd3d/detector.pt.
+# Environment: DETECTOR (default models/lwd3d/detector.pt); RELATION_DATA (the relation set, default
+# data/sim_relation_urban, simulated when missing with seeds 3000-3011); HELDOUT_SEED (another held-out set, as
+# scripts/eval_heldout.sh: a fresh one for a new detector).
+# Work files: out/ablate_intra_sim/.
 set -eo pipefail
 cd "$(dirname "$0")/.."
 set +u
@@ -13,8 +16,9 @@ source scripts/env.sh
 set -u
 OUT=out/ablate_intra_sim
 DET=${DETECTOR:-models/lwd3d/detector.pt}
-# Results of another detector are stale: start afresh when it changed.
-stamp=$(md5sum "$DET" | cut -c1-32)
+DATA=${RELATION_DATA:-data/sim_relation_urban}
+# Results of another detector, relation set or held-out set are stale: start afresh when one changed.
+stamp="$(md5sum "$DET" | cut -c1-32) $DATA ${HELDOUT_SEED:-9000}"
 if [ "$(cat "$OUT/detector.md5" 2>/dev/null)" != "$stamp" ]; then rm -rf "$OUT" out/heldout/base out/heldout/intra_lwd3d*; fi
 mkdir -p "$OUT"
 echo "$stamp" >"$OUT/detector.md5"
@@ -23,7 +27,6 @@ if [ ${#CONFIGS[@]} -eq 0 ]; then
   CONFIGS=(intra_lwd3d intra_lwd3d_no_edge intra_lwd3d_r1 intra_lwd3d_r4 intra_lwd3d_m1 intra_lwd3d_m2 intra_lwd3d_m6)
 fi
 source scripts/simulate_once.sh
-DATA=data/sim_relation_urban
 simulate_once "$DATA" config/sim/urban_street.yaml 12 80 3000
 
 train() {  # config
