@@ -11,10 +11,19 @@
 #      the best is installed as models/lwd3d/detector.pt. The inference options (box voting, IoU-score power, point
 #      refinement) were chosen on the tuning set and are written in the last stage's YAML;
 #   5. (session 10) fine-tunes the result 4 epochs with sim-to-real augmentation and ground-truth sampling
-#      (config/detector/lwd3d_<head>_robust.yaml), kept when it validates better.
+#      (config/detector/lwd3d_<head>_robust.yaml), kept when it validates better;
+#   6. (sessions 11 and 12; needs ../shared/data or RET3D_SHARED_DATA, skipped with a message without it) two rounds
+#      of 2 epochs each with the 37 unlabelled real KITTI scans taught as background
+#      (config/detector/lwd3d_anchor_selftrain.yaml, `scripts/real_negatives.py` labelling them from the previous
+#      round's detector), refits the car and pedestrian score calibration on the relation set
+#      (`scripts/fit_score_calibration.py`) and installs the result with that calibration;
+#   7. trains IntraRM and InterRM behind the installed detector on the relation set and installs them.
+# The data folders are named for the simulator that made them (data/sim3_*: session 12's, whose pedestrian labels
+# have KITTI's proportions); a folder made by an older simulator is not reused.
 # Resumable: run it again after a stop and it continues from the last checkpoint (every 5 minutes); finished steps
 # are skipped. On the idle 2-core machine about 55 minutes for the two heads, 40 for the second stage and 20 for the
-# third (112 in all; on a host slowed by other load, up to twice that). Work goes to data/ and out/train_default/.
+# third (112 in all; on a host slowed by other load, up to twice that), then about 30 for steps 5-7. Work goes to
+# data/ and out/train_default/. The figures of a reproduction belong in models/lwd3d/MODEL_CARD.md.
 set -eo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$(pwd)
@@ -29,13 +38,13 @@ source scripts/simulate_once.sh
 simulate() {  # name config sequences frames seed
   simulate_once "data/$1" "$2" "$3" "$4" "$5" "$OUT/$1.log"
 }
-simulate sim_train_urban config/sim/urban_street.yaml 32 80 1000
-simulate sim_train_highway config/sim/highway.yaml 8 60 2000
-simulate sim_val_urban config/sim/urban_street.yaml 2 50 5000
+simulate sim3_train_urban config/sim/urban_street.yaml 32 80 1000
+simulate sim3_train_highway config/sim/highway.yaml 8 60 2000
+simulate sim3_val_urban config/sim/urban_street.yaml 2 50 5000
 
 train() {  # head
   if [ -f "$OUT/$1.pt" ] && [ -f "$OUT/$1.done" ]; then return; fi
-  ret3d train detector --data data/sim_train_urban data/sim_train_highway --config "config/detector/lwd3d_$1.yaml" \
+  ret3d train detector --data data/sim3_train_urban data/sim3_train_highway --config "config/detector/lwd3d_$1.yaml" \
     --out "$OUT/$1.pt" --threads 1 --resume >"$OUT/train_$1.log" 2>&1
   touch "$OUT/$1.done"
 }
@@ -51,9 +60,9 @@ echo "training took $(( ($(date +%s) - start) / 60 )) min (this run)"
 validate() {  # name model: prints the mean of the three classes' 3D AP R40 moderate on the validation set
   mkdir -p "$OUT/val_$1"
   cp "$2" "$OUT/val_$1/detector.pt"
-  ret3d detect --data data/sim_val_urban --models "$OUT/val_$1" --out "$OUT/val_$1/pred" --stages base \
+  ret3d detect --data data/sim3_val_urban --models "$OUT/val_$1" --out "$OUT/val_$1/pred" --stages base \
     >"$OUT/val_$1/detect.log" 2>&1
-  ret3d eval --gt data/sim_val_urban --pred "$OUT/val_$1/pred" --out "$OUT/val_$1/eval" >"$OUT/val_$1/eval.log" 2>&1
+  ret3d eval --gt data/sim3_val_urban --pred "$OUT/val_$1/pred" --out "$OUT/val_$1/eval" >"$OUT/val_$1/eval.log" 2>&1
   python3 -c "
 import json
 m = json.load(open('$OUT/val_$1/eval/metrics.json'))
@@ -81,7 +90,7 @@ stage() {  # stage-name init-model [extra ret3d train detector options]
   if [ ! -f "$OUT/$name.done" ]; then
     local t0
     t0=$(date +%s)
-    ret3d train detector --data data/sim_train_urban data/sim_train_highway \
+    ret3d train detector --data data/sim3_train_urban data/sim3_train_highway \
       --config "config/detector/lwd3d_$name.yaml" --init "$init" --out "$OUT/$name.pt" \
       --threads 2 --resume "$@" >"$OUT/train_$name.log" 2>&1
     touch "$OUT/$name.done"
@@ -99,9 +108,111 @@ stage stage2 "$OUT/$best_head.pt"
 # the training sets' objects; models/lwd3d/MODEL_CARD.md). Its score calibration was refitted afterwards on the
 # relation set (scripts/fit_score_calibration.py) and written into that YAML.
 if [ -f "config/detector/lwd3d_${best_head}_robust.yaml" ] && [ -f "$OUT/${best_head}_stage3.pt" ]; then
-  [ -f data/gtdb/sim_train.gtdb ] || ret3d train gtdb --data data/sim_train_urban data/sim_train_highway \
-    --config "config/detector/lwd3d_${best_head}_robust.yaml" --out data/gtdb/sim_train.gtdb >"$OUT/gtdb.log" 2>&1
-  stage robust "$OUT/${best_head}_stage3.pt" --gt-database data/gtdb/sim_train.gtdb
+  [ -f data/gtdb/sim3_train.gtdb ] || ret3d train gtdb --data data/sim3_train_urban data/sim3_train_highway \
+    --config "config/detector/lwd3d_${best_head}_robust.yaml" --out data/gtdb/sim3_train.gtdb >"$OUT/gtdb.log" 2>&1
+  stage robust "$OUT/${best_head}_stage3.pt" --gt-database data/gtdb/sim3_train.gtdb
+fi
+
+# Sessions 11-12: the real scans as background, two rounds. Each round labels the 37 unlabelled real scans from the
+# previous detector's boxes at score >= 0.05 (a pedestrian or cyclist box embedded in structure stays background,
+# every other box scoring >= 0.1 becomes DontCare; scripts/real_negatives.py) and trains 2 epochs from its weights.
+DATA_DIR=${RET3D_SHARED_DATA:-$ROOT/../shared/data}
+simulate sim3_relation_urban config/sim/urban_street.yaml 12 80 3000
+# DIR: an object layout of symlinks to the 37 unlabelled scans (the consecutive ones 000000-000021 as frames
+# 900000-900021), each with the calibration of KITTI's 2011-09-26 recordings (kitti_tracking's 0001.txt, the values
+# of kitti::defaultCalibration(); scripts/real_negatives.py reads it to bring the detector's boxes back to the LiDAR).
+real_folder() {
+  local dir=$1 f fr calib
+  calib=$(realpath "$DATA_DIR/kitti_tracking/training/calib/0001.txt")
+  mkdir -p "$dir/training/velodyne" "$dir/training/calib"
+  for f in "$DATA_DIR"/kitti_object/unlabeled/velodyne/*.bin "$DATA_DIR"/unlabeled_scans/*.bin; do
+    fr=$(basename "$f" .bin)
+    [[ "$f" == */unlabeled_scans/* ]] && fr=$(printf '9%05d' $((10#$fr)))
+    ln -sfn "$(realpath "$f")" "$dir/training/velodyne/$fr.bin"
+    ln -sfn "$calib" "$dir/training/calib/$fr.txt"
+  done
+}
+selftrain() {  # round init-model
+  local name=selftrain_$1 real=data/real_unl_round$1
+  [ -f "$OUT/$name.done" ] && { model="$OUT/$name.pt"; return; }
+  real_folder "$real"
+  ret3d detect --data "$real" --detector-model "$2" --stages base --score-threshold 0.05 --out "$OUT/${name}_real_pred" \
+    >"$OUT/${name}_real_pred.log" 2>&1
+  python3 scripts/real_negatives.py "$real" "$OUT/${name}_real_pred" >"$OUT/${name}_labels.log"
+  ret3d train detector --data data/sim3_train_urban data/sim3_train_highway "$real" --data-weights 1 1 12 \
+    --labels-cover all all all --config config/detector/lwd3d_anchor_selftrain.yaml --init "$2" \
+    --gt-database data/gtdb/sim3_train.gtdb --out "$OUT/$name.pt" --threads 2 --resume >"$OUT/train_$name.log" 2>&1
+  touch "$OUT/$name.done"
+  model="$OUT/$name.pt"
+  echo "real-background round $1: $(tail -n 1 "$OUT/${name}_labels.log"); model $model"
+}
+# The score calibration of config/detector/lwd3d_anchor_selftrain.yaml refitted for the last round's weights: its
+# boxes on the relation set without calibration, a logistic fit per class, the weights written into a copy of the
+# config, and the model saved again with it (the train command once more with --resume: no step, the config stored).
+calibrate() {
+  local nocal=$OUT/selftrain_nocal.yaml cal=$OUT/selftrain_calibrated.yaml pred=$OUT/calib_pred
+  [ -f "$OUT/calibrated.done" ] && return
+  python3 - config/detector/lwd3d_anchor_selftrain.yaml "$nocal" <<'PY'
+import sys
+lines = open(sys.argv[1]).read().split("\n")
+out, skip = [], False
+for l in lines:
+    if l.strip().startswith("score_calibration:"):
+        skip = True
+        continue
+    if skip and l.startswith("      "):
+        continue
+    skip = False
+    out.append(l)
+open(sys.argv[2], "w").write("\n".join(out))
+PY
+  ret3d detect --data data/sim3_relation_urban --detector-model "$model" --detector-config "$nocal" --stages base \
+    --out "$pred" >"$OUT/calib_detect.log" 2>&1
+  python3 scripts/fit_score_calibration.py --gt data/sim3_relation_urban --pred "$pred" --class Car >"$OUT/calib_car.log"
+  python3 scripts/fit_score_calibration.py --gt data/sim3_relation_urban --pred "$pred" --class Pedestrian --iou 0.5 \
+    --no-shape >"$OUT/calib_ped.log"
+  python3 - "$nocal" "$cal" "$OUT/calib_car.log" "$OUT/calib_ped.log" <<'PY'
+import re, sys
+weights = {}
+for log in sys.argv[3:]:
+    m = re.search(r"score_calibration: \{(\w+): (\[[^]]*\])\}", open(log).read())
+    weights[m.group(1)] = m.group(2)
+out = []
+for l in open(sys.argv[1]).read().split("\n"):
+    out.append(l)
+    if l.strip().startswith("centroid:"):
+        out.append("    score_calibration:   # refitted by scripts/train_default.sh")
+        out += ["      %s: %s" % (c, w) for c, w in sorted(weights.items())]
+open(sys.argv[2], "w").write("\n".join(out))
+PY
+  ret3d train detector --data data/sim3_train_urban data/sim3_train_highway data/real_unl_round2 --data-weights 1 1 12 \
+    --labels-cover all all all --config "$cal" --init "$OUT/selftrain_1.pt" --gt-database data/gtdb/sim3_train.gtdb \
+    --out "$OUT/selftrain_2.pt" --threads 2 --resume >"$OUT/calib_save.log" 2>&1
+  touch "$OUT/calibrated.done"
+  echo "score calibration: $(tail -n 2 "$OUT/calib_car.log" | head -n 1); $(tail -n 2 "$OUT/calib_ped.log" | head -n 1)"
+}
+if [ -d "$DATA_DIR/kitti_object/unlabeled/velodyne" ] && [ -d "$DATA_DIR/unlabeled_scans" ] &&
+   [ -f "$DATA_DIR/kitti_tracking/training/calib/0001.txt" ]; then
+  selftrain 1 "$model"
+  selftrain 2 "$model"
+  calibrate
+  best="real-background rounds 1-2, calibration refitted (not selected on validation: the recipe of the model card)"
+else
+  echo "train_default.sh: no unlabelled real scans at $DATA_DIR (set RET3D_SHARED_DATA): the real-background rounds" \
+       "are skipped; the installed detector is the simulated-only one (as models/lwd3d_sim)" >&2
 fi
 cp "$model" models/lwd3d/detector.pt
 echo "default detector: $model ($best; validation mean 3D AP R40 moderate $best_ap) -> models/lwd3d/detector.pt"
+
+# IntraRM and InterRM behind the installed detector, on the relation set (sequences 0-9 train, 10-11 validation).
+if [ ! -f "$OUT/relation.done" ]; then
+  ret3d train intra --data data/sim3_relation_urban --detector models/lwd3d/detector.pt \
+    --config config/relation/intra_lwd3d_m1.yaml --sequences 0-9 --val-sequences 10-11 --threads 2 \
+    --out "$OUT/intra_rm.pt" >"$OUT/train_intra.log" 2>&1
+  ret3d train inter --data data/sim3_relation_urban --detector models/lwd3d/detector.pt --intra-model "$OUT/intra_rm.pt" \
+    --tracker-config config/tracker_lwd3d.yaml --config config/relation/inter_lwd3d.yaml --sequences 0-9 \
+    --val-sequences 10-11 --threads 2 --out "$OUT/inter_rm.pt" >"$OUT/train_inter.log" 2>&1
+  touch "$OUT/relation.done"
+fi
+cp "$OUT/intra_rm.pt" "$OUT/inter_rm.pt" models/lwd3d/
+echo "relation modules: $(tail -n 1 "$OUT/train_intra.log"); $(tail -n 1 "$OUT/train_inter.log") -> models/lwd3d/"

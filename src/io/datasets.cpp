@@ -117,5 +117,10 @@ std::string ObjectDataset::calibPath(const std::string& frame) const {
   return (fs::path(dir_) / "calib" / (frame + ".txt")).string();
 }
 
+Calibration ObjectDataset::calibration(const std::string& frame) const {
+  if (!fs::is_directory(fs::path(dir_) / "calib")) return defaultCalibration();
+  return readCalibration(calibPath(frame));
+}
+
 }  // namespace kitti
 }  // namespace ret3d

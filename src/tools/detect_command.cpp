@@ -113,7 +113,7 @@ std::size_t detectObjectFrames(const DetectArgs& a, DetectFrame detect) {
   ProgressBar bar("detect", frames.size());
   std::size_t boxes = 0;
   for (const std::string& fr : frames) {
-    const kitti::Calibration calib = kitti::readCalibration(ds.calibPath(fr));
+    const kitti::Calibration calib = ds.calibration(fr);
     const Detections d = detect(ds, fr, calib);
     boxes += d.size();
     kitti::writeObjectLabels(a.out + "/" + fr + ".txt", toLabels(d, calib, -1));

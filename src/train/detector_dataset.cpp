@@ -164,7 +164,7 @@ void DetectorDataset::addTracking(std::size_t set, CoverEvidence* evidence) {
     s.name = name;
     s.poses = ds.lidarPoses(name);
     if (s.poses.empty()) RET3D_WARN("sequence " << name << ": no poses; the ego motion is taken as zero");
-    const kitti::Calibration calib = kitti::readCalibration(ds.calibPath(name));
+    const kitti::Calibration calib = ds.calibration(name);
     s.calib = calib;
     const int last = frames.back();
     s.boxes.resize(last + 1);
@@ -200,7 +200,7 @@ void DetectorDataset::addObject(std::size_t set, CoverEvidence* evidence) {
       unlabelled.push_back(name);
       continue;
     }
-    const kitti::Calibration calib = kitti::readCalibration(ds.calibPath(name));
+    const kitti::Calibration calib = ds.calibration(name);
     Sequence s;
     s.set = set;
     s.object = true;

@@ -109,7 +109,7 @@ std::vector<IntraRMFrame> loadIntraFrames(const IntraDataOptions& data, const re
       if (!fs::exists(ds.labelPath(fr))) continue;
       const auto dets = io::readFrameDetections(data.detections_dir, fr);
       IntraRMFrame f = makeFrame(dets, kitti::readObjectLabels(ds.labelPath(fr)),
-                                 kitti::readCalibration(ds.calibPath(fr)), config);
+                                 ds.calibration(fr), config);
       if (!f.detections.empty()) frames.push_back(std::move(f));
     }
   }

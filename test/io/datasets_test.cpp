@@ -141,6 +141,14 @@ TEST(ObjectDataset, ListsFramesAndPaths) {
   EXPECT_EQ(ds.labelPath("000003"), tmp / "label_2/000003.txt");
   EXPECT_EQ(ds.calibPath("000003"), tmp / "calib/000003.txt");
 
+  // Unlabelled scans in the object layout need no calib/: they take the default calibration, as a folder of scans
+  // does in the tracking layout. Once calib/ exists, a frame without its file is an error, never the default.
+  const kitti::Calibration def = kitti::defaultCalibration();
+  EXPECT_TRUE(ds.calibration("000007").velo_to_cam.matrix().isApprox(def.velo_to_cam.matrix()));
+  EXPECT_TRUE(ds.calibration("000007").P2.isApprox(def.P2));
+  fs::create_directories(tmp / "calib");
+  EXPECT_THROW(ds.calibration("000007"), std::runtime_error);
+
   const auto data = test::sharedDataDir();
   if (!data) GTEST_SKIP() << test::kSharedDataMissing;
   const kitti::ObjectDataset real(*data + "/kitti_object");

@@ -185,6 +185,9 @@ class ObjectDataset {
   std::string velodynePath(const std::string& frame) const;
   std::string labelPath(const std::string& frame) const;
   std::string calibPath(const std::string& frame) const;
+  // The frame's calib/ file; for a folder without calib/ at all (unlabelled scans), defaultCalibration(). A calib/
+  // folder that lacks the frame's file is an error (readCalibration throws, naming the file).
+  Calibration calibration(const std::string& frame) const;
 
  private:
   std::string dir_;
