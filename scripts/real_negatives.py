@@ -26,19 +26,7 @@ import sys
 
 import numpy as np
 
-
-def read_calib(path):
-    m = {}
-    for line in open(path):
-        if ":" not in line:
-            continue
-        k, v = line.split(":", 1)
-        m[k.strip()] = np.array([float(x) for x in v.split()])
-    r0 = np.eye(4)
-    r0[:3, :3] = m["R0_rect"].reshape(3, 3)
-    tr = np.eye(4)
-    tr[:3, :4] = m["Tr_velo_to_cam"].reshape(3, 4)
-    return np.linalg.inv(r0 @ tr)  # camera (rectified) -> velodyne
+from fit_score_calibration import load_calib  # camera (rectified) -> LiDAR, from a KITTI calib file
 
 
 def read_boxes(path, cam_to_velo):
@@ -111,7 +99,7 @@ def main():
     counts = {}
     for scan in scans:
         frame = os.path.splitext(os.path.basename(scan))[0]
-        cam_to_velo = read_calib(os.path.join(tr, "calib", frame + ".txt"))
+        cam_to_velo = load_calib(os.path.join(tr, "calib", frame + ".txt"))
         velo_to_cam = np.linalg.inv(cam_to_velo)
         pts = np.fromfile(scan, dtype=np.float32).reshape(-1, 4)[:, :3].astype(np.float64)
         lines = []
