@@ -15,7 +15,7 @@
 #   6. (sessions 11 and 12; needs ../shared/data or RET3D_SHARED_DATA, skipped with a message without it) two rounds
 #      of 2 epochs each with the 37 unlabelled real KITTI scans taught as background
 #      (config/detector/lwd3d_anchor_selftrain.yaml, `scripts/real_negatives.py` labelling them from the previous
-#      round's detector), refits the car and pedestrian score calibration on the relation set
+#      round's detector), refits the car, pedestrian and cyclist score calibration on the relation set
 #      (`scripts/fit_score_calibration.py`) and installs the result with that calibration;
 #   7. trains IntraRM and InterRM behind the installed detector on the relation set and installs them.
 # The data folders are named for the simulator that made them (data/sim3_*: session 12's, whose pedestrian labels
@@ -166,12 +166,15 @@ for l in lines:
     out.append(l)
 open(sys.argv[2], "w").write("\n".join(out))
 PY
+  # Fitted on the boxes the network scores >= 0.3 (uncalibrated, the candidates are the published boxes).
   ret3d detect --data data/sim3_relation_urban --detector-model "$model" --detector-config "$nocal" --stages base \
-    --out "$pred" >"$OUT/calib_detect.log" 2>&1
+    --score-threshold 0.3 --out "$pred" >"$OUT/calib_detect.log" 2>&1
   python3 scripts/fit_score_calibration.py --gt data/sim3_relation_urban --pred "$pred" --class Car >"$OUT/calib_car.log"
   python3 scripts/fit_score_calibration.py --gt data/sim3_relation_urban --pred "$pred" --class Pedestrian --iou 0.5 \
     --no-shape >"$OUT/calib_ped.log"
-  python3 - "$nocal" "$cal" "$OUT/calib_car.log" "$OUT/calib_ped.log" <<'PY'
+  python3 scripts/fit_score_calibration.py --gt data/sim3_relation_urban --pred "$pred" --class Cyclist --iou 0.5 \
+    --no-shape >"$OUT/calib_cyc.log"
+  python3 - "$nocal" "$cal" "$OUT/calib_car.log" "$OUT/calib_ped.log" "$OUT/calib_cyc.log" <<'PY'
 import re, sys
 weights = {}
 for log in sys.argv[3:]:
@@ -189,7 +192,8 @@ PY
     --labels-cover all all all --config "$cal" --init "$OUT/selftrain_1.pt" --gt-database data/gtdb/sim3_train.gtdb \
     --out "$OUT/selftrain_2.pt" --threads 2 --resume >"$OUT/calib_save.log" 2>&1
   touch "$OUT/calibrated.done"
-  echo "score calibration: $(tail -n 2 "$OUT/calib_car.log" | head -n 1); $(tail -n 2 "$OUT/calib_ped.log" | head -n 1)"
+  echo "score calibration: $(tail -n 2 "$OUT/calib_car.log" | head -n 1); $(tail -n 2 "$OUT/calib_ped.log" | head -n 1);" \
+    "$(tail -n 2 "$OUT/calib_cyc.log" | head -n 1)"
 }
 if [ -d "$DATA_DIR/kitti_object/unlabeled/velodyne" ] && [ -d "$DATA_DIR/unlabeled_scans" ] &&
    [ -f "$DATA_DIR/kitti_tracking/training/calib/0001.txt" ]; then

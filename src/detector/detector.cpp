@@ -1,5 +1,6 @@
 #include "ret3d/detector/detector.h"
 
+#include <algorithm>
 #include <chrono>
 
 #include <torch/torch.h>
@@ -86,6 +87,10 @@ Detections Detector::detect(const PointCloud& current, const PointCloud* previou
   t0 = std::chrono::steady_clock::now();
   if (options_.inference.point_refine.enabled()) refineBoxesFromPoints(current, &det.boxes, options_.inference.point_refine);
   headingFromVelocity(&det.boxes, options_.inference.heading_from_velocity);
+  // Calibrated classes were let in below score_threshold (candidate_threshold): their final scores decide.
+  const float min_score = options_.inference.score_threshold;
+  det.boxes.erase(std::remove_if(det.boxes.begin(), det.boxes.end(), [&](const Box& b) { return b.score < min_score; }),
+                  det.boxes.end());
   timings_.refine_ms = msSince(t0);
 
   // The features o_i belong to decoding (Ret3D §3.1): timed with it.

@@ -68,6 +68,12 @@ BevGeometry DetectorOptions::inferenceGeometry() const {
   return g;
 }
 
+float InferenceOptions::candidateThreshold(ObjectClass c) const {
+  for (const auto& [calibrated, weights] : point_refine.score_calibration)
+    if (calibrated == c) return std::min(candidate_threshold, score_threshold);
+  return score_threshold;
+}
+
 void DetectorOptions::validateGridExtent() const {
   if (inference.grid_extent.empty()) return;
   if (inference.grid_extent.size() != 4) throw std::invalid_argument("expected [x_min, x_max, y_min, y_max]");
@@ -206,6 +212,10 @@ void readInference(MapReader r, InferenceOptions* o) {
   r.get("model_path", &o->model_path);
   r.get("threads", &o->threads);
   r.get("score_threshold", &o->score_threshold);
+  r.get("candidate_threshold", &o->candidate_threshold);
+  for (const auto& [key, v] : {std::pair<const char*, float>{"score_threshold", o->score_threshold},
+                                {"candidate_threshold", o->candidate_threshold}})
+    if (!(v >= 0 && v <= 1)) r.fail(r.full(key), "must lie in [0, 1]");
   r.get("max_candidates", &o->max_candidates);
   r.get("max_detections", &o->max_detections);
   r.get("nms_iou", &o->nms_iou);

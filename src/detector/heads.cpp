@@ -64,9 +64,11 @@ torch::Tensor sigmoidFocal(const torch::Tensor& logits, const torch::Tensor& tar
   return (a * (1 - pt).pow(gamma) * ce * weight).sum();
 }
 
-// Flat indices and scores of the cells above the score threshold, at most max_candidates of the best; false if none.
-bool selectCandidates(const torch::Tensor& scores, const InferenceOptions& o, torch::Tensor* keep, torch::Tensor* vals) {
-  *keep = torch::nonzero(scores > o.score_threshold).view({-1});
+// Flat indices and scores of the cells of class c above its candidate threshold, at most max_candidates of the best;
+// false if none.
+bool selectCandidates(const torch::Tensor& scores, ObjectClass c, const InferenceOptions& o, torch::Tensor* keep,
+                      torch::Tensor* vals) {
+  *keep = torch::nonzero(scores > o.candidateThreshold(c)).view({-1});
   if (keep->numel() == 0) return false;
   *vals = scores.index({*keep});
   if (keep->numel() > o.max_candidates) {
@@ -239,7 +241,7 @@ class AnchorHead : public DetectionHead {
       for (int c = 0; c < C_; ++c) {
         auto sc = score.index({Slice(), c}).reshape({-1});
         torch::Tensor keep, vals;
-        if (!selectCandidates(sc, o, &keep, &vals)) continue;
+        if (!selectCandidates(sc, config_.classes[c], o, &keep, &vals)) continue;
         auto ka = keep.accessor<int64_t, 1>();
         auto va = vals.accessor<float, 1>();
         for (int64_t i = 0; i < keep.numel(); ++i) {
@@ -383,7 +385,7 @@ class CenterHead : public DetectionHead {
     for (int c = 0; c < C_; ++c) {
       auto sc = heat[c].reshape({-1});
       torch::Tensor keep, vals;
-      if (!selectCandidates(sc, o, &keep, &vals)) continue;
+      if (!selectCandidates(sc, config_.classes[c], o, &keep, &vals)) continue;
       auto ka = keep.accessor<int64_t, 1>();
       auto va = vals.accessor<float, 1>();
       for (int64_t i = 0; i < keep.numel(); ++i) {

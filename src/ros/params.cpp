@@ -183,6 +183,7 @@ DetectorNodeletParams loadDetectorNodeletParams(const ros::NodeHandle& private_n
   InferenceOptions& inf = params.detector.inference;
   inf.threads = p.integer("threads", inf.threads, 1, 64);
   inf.score_threshold = static_cast<float>(p.number("score_threshold", inf.score_threshold, 0.0, 1.0));
+  inf.candidate_threshold = static_cast<float>(p.number("candidate_threshold", inf.candidate_threshold, 0.0, 1.0));
   inf.nms_iou = p.number("nms_iou", inf.nms_iou, 0.01, 1.0);
   inf.nms_voting_iou = p.number("nms_voting_iou", inf.nms_voting_iou, 0.0, 1.0);
   inf.iou_score_power = p.number("iou_score_power", inf.iou_score_power, 0.0, 1.0);

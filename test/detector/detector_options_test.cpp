@@ -53,6 +53,8 @@ TEST(DetectorOptions, MistakesAreRefusedNamingTheFileAndKey) {
   EXPECT_THROW(detectorOptionsFromYaml("model: {bev: {x_min: -45, x_max: 45}}"), std::runtime_error);
   EXPECT_THROW(detectorOptionsFromYaml("model: {head: center, center: {stride: 2}}"), std::runtime_error);
   EXPECT_THROW(detectorOptionsFromYaml("model: {bev: {x_min: 0, x_max: 0}}"), std::runtime_error);
+  EXPECT_THROW(detectorOptionsFromYaml("inference: {score_threshold: 1.5}"), std::runtime_error);
+  EXPECT_THROW(detectorOptionsFromYaml("inference: {candidate_threshold: -0.1}"), std::runtime_error);
 }
 
 TEST(DetectorOptions, TheInferenceGridExtentIsReadAndChecked) {

@@ -72,9 +72,16 @@ struct ModelConfig {
 struct InferenceOptions {
   std::string model_path;      // empty: the network is freshly initialised (tests, training)
   int threads = 2;             // torch intra-op threads and BEV workers
-  // Candidates below this score are dropped before NMS. A calibrated class (point_refine.score_calibration) is
-  // re-scored after NMS, so its published scores may fall below it: downstream thresholds (the tracker's) see those.
+  // The lowest published score: a box scoring less after NMS and refinement is dropped. An uncalibrated class's
+  // candidates need it before NMS already (its score does not change after).
   float score_threshold = 0.3f;
+  // The network score a candidate of a calibrated class (point_refine.score_calibration) needs before NMS; its
+  // calibrated score, from the returns that hold the refined box, must then reach score_threshold. A far car's
+  // network score is low (few returns in its cells) where its calibrated score need not be. Used as
+  // min(candidate_threshold, score_threshold).
+  float candidate_threshold = 0.05f;
+  // The threshold a candidate of class c needs before NMS (the two above).
+  float candidateThreshold(ObjectClass c) const;
   int max_candidates = 500;    // per class before NMS
   int max_detections = 200;    // after NMS
   double nms_iou = 0.1;        // rotated BEV IoU, per class
