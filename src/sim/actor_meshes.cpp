@@ -103,8 +103,9 @@ TriangleMesh carMesh(CarBody body, double length, double width, double height, c
   return mesh;
 }
 
-TriangleMesh pedestrianMesh(double stature, double breadth, double phase, double swing, const ActorSurfaces& s) {
-  const float H = static_cast<float>(stature), B = static_cast<float>(breadth);
+TriangleMesh pedestrianMesh(const PersonShape& person, double phase, double swing, const ActorSurfaces& s) {
+  const float H = static_cast<float>(person.stature), B = static_cast<float>(person.breadth);
+  const float D = static_cast<float>(person.depth);
   const float sw = static_cast<float>(swing), ph = static_cast<float>(phase);
   TriangleMesh mesh;
   const float hip_z = 0.53f * H, shoulder_z = 0.81f * H, thigh = 0.245f * H, shin = 0.245f * H;
@@ -124,10 +125,14 @@ TriangleMesh pedestrianMesh(double stature, double breadth, double phase, double
     Eigen::Isometry3f T = translation(a.x() + 0.06f, a.y(), std::max(a.z() - 0.02f, 0.04f));
     mesh.addBox(T, V3(0.25f, 0.09f, 0.08f), s.tire);
   }
-  // Torso (slightly tapered box) and head.
+  // Torso (a box as deep as the build, the arms beside it making up the breadth) and head.
   Eigen::Isometry3f T = translation(0, 0, 0.5f * (hip_z + shoulder_z) - 0.02f * H);
-  const float torso_w = B - 0.17f * H / 1.75f;
-  mesh.addBox(T, V3(0.13f * H, torso_w, shoulder_z - hip_z + 0.03f * H), s.clothing);
+  const float arm = 0.10f * H / 1.75f;  // upper arm in a sleeve
+  const float torso_w = B - 2 * arm;
+  mesh.addBox(T, V3(D, torso_w, shoulder_z - hip_z + 0.03f * H), s.clothing);
+  if (person.backpack) {
+    mesh.addBox(translation(-0.5f * D - 0.07f, 0, shoulder_z - 0.14f * H), V3(0.14f, 0.30f, 0.40f), s.clothing2);
+  }
   mesh.addBeam(V3(0, 0, shoulder_z), V3(0, 0, 0.88f * H), 0.07f * H, s.skin);
   mesh.addEllipsoid(translation(0.01f * H, 0, 0.935f * H), V3(0.058f * H, 0.05f * H, 0.065f * H), 8, 5, s.skin);
   // Arms swing opposite to the legs.
@@ -135,12 +140,12 @@ TriangleMesh pedestrianMesh(double stature, double breadth, double phase, double
   for (int side = -1; side <= 1; side += 2) {
     const float p = ph + (side > 0 ? static_cast<float>(M_PI) : 0.0f);
     const float sh = 0.8f * sw * std::sin(p);
-    const V3 a(0, side * 0.5f * (torso_w + 0.08f * H / 1.75f), shoulder_z - 0.02f * H);
+    const V3 a(0, side * 0.5f * (torso_w + arm), shoulder_z - 0.02f * H);
     const V3 e = a + V3(upper * std::sin(sh), 0, -upper * std::cos(sh));
     const float fa = sh + 0.3f * sw + 0.15f;
     const V3 w = e + V3(fore * std::sin(fa), 0, -fore * std::cos(fa));
-    mesh.addBeam(a, e, 0.08f * H / 1.75f, s.clothing);
-    mesh.addBeam(e, w, 0.07f * H / 1.75f, s.skin);
+    mesh.addBeam(a, e, arm, s.clothing);
+    mesh.addBeam(e, w, 0.08f * H / 1.75f, s.clothing);
   }
   return mesh;
 }

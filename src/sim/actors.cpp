@@ -10,6 +10,8 @@ namespace sim {
 
 namespace {
 
+PersonShape personShape(const Actor& a) { return {a.stature, a.breadth, a.depth, a.backpack}; }
+
 using V2 = Eigen::Vector2d;
 
 double draw(Rng& rng, const Range& r) { return rng.uniform(r.lo, r.hi); }
@@ -55,12 +57,12 @@ void fitArticulatedBox(Actor& a, Rng& rng) {
   Eigen::AlignedBox3f b;
   for (int k = 0; k < 16; ++k) {
     const double ph = 2 * M_PI * k / 16;
-    TriangleMesh m = a.kind == ActorKind::Pedestrian ? pedestrianMesh(a.stature, a.breadth, ph, a.swing_max, a.surfaces)
+    TriangleMesh m = a.kind == ActorKind::Pedestrian ? pedestrianMesh(personShape(a), ph, a.swing_max, a.surfaces)
                                                      : cyclistMesh(a.length, a.stature, ph, a.surfaces);
     b.extend(m.bounds());
-    if (a.kind == ActorKind::Pedestrian) b.extend(pedestrianMesh(a.stature, a.breadth, ph, 0.5 * a.swing_max, a.surfaces).bounds());
+    if (a.kind == ActorKind::Pedestrian) b.extend(pedestrianMesh(personShape(a), ph, 0.5 * a.swing_max, a.surfaces).bounds());
   }
-  if (a.kind == ActorKind::Pedestrian) b.extend(pedestrianMesh(a.stature, a.breadth, 0, 0, a.surfaces).bounds());
+  if (a.kind == ActorKind::Pedestrian) b.extend(pedestrianMesh(personShape(a), 0, 0, a.surfaces).bounds());
   const double m = kLabelMargin;
   a.length = b.sizes().x() + 2 * m;
   a.width = b.sizes().y() + 2 * m;
@@ -136,7 +138,7 @@ TriangleMesh actorMesh(const Actor& a) {
   const double phase = 2 * M_PI * var / kPhaseSteps;
   switch (a.kind) {
     case ActorKind::Pedestrian:
-      return pedestrianMesh(a.stature, a.breadth, phase, var == kPhaseSteps ? 0.0 : a.swing_max, a.surfaces);
+      return pedestrianMesh(personShape(a), phase, var == kPhaseSteps ? 0.0 : a.swing_max, a.surfaces);
     case ActorKind::Cyclist: return cyclistMesh(a.length, a.stature, phase, a.surfaces);
     default: return carMesh(a.body, a.length, a.width, a.height, a.surfaces);
   }
@@ -577,7 +579,11 @@ void Traffic::spawn(Rng& rng, double view_range) {
         a.kind = ActorKind::Pedestrian;
         a.surfaces = drawSurfaces(config_, rng);
         a.stature = std::clamp(rng.normal(1.72, 0.09), 1.45, 2.0);
-        a.breadth = std::clamp(rng.normal(0.44, 0.03), 0.36, 0.52) * a.stature / 1.72;
+        // Shoulder breadth across the arms, clothes included (bideltoid breadth: about 0.50 m in men, 0.43 in women).
+        a.breadth = std::clamp(rng.normal(0.48, 0.035), 0.40, 0.58) * a.stature / 1.72;
+        // Chest depth (anthropometric surveys: 0.22-0.27 m) with clothes; coats and bags vary it.
+        a.depth = std::clamp(rng.normal(0.28, 0.03), 0.22, 0.36) * a.stature / 1.72;
+        a.backpack = rng.chance(0.2);
         a.v_cruise = draw(rng, tc.pedestrian_speed);
         a.swing_max = std::clamp(0.22 + 0.12 * a.v_cruise, 0.2, 0.5);
         a.phase = rng.uniform(0, 2 * M_PI);

@@ -55,7 +55,7 @@ TEST(ActorMeshes, PedestrianWalksAndCyclistPedals) {
   // Over a gait cycle the legs swing: the mesh's length changes, its height does not.
   double lmin = 1e9, lmax = 0;
   for (int k = 0; k < 16; ++k) {
-    const Eigen::AlignedBox3f b = pedestrianMesh(1.75, 0.45, 2 * M_PI * k / 16, 0.4, plain()).bounds();
+    const Eigen::AlignedBox3f b = pedestrianMesh({1.75, 0.45}, 2 * M_PI * k / 16, 0.4, plain()).bounds();
     lmin = std::min(lmin, static_cast<double>(b.sizes().x()));
     lmax = std::max(lmax, static_cast<double>(b.sizes().x()));
     EXPECT_NEAR(b.max().z(), 1.75, 0.06);
@@ -63,6 +63,12 @@ TEST(ActorMeshes, PedestrianWalksAndCyclistPedals) {
   }
   EXPECT_GT(lmax - lmin, 0.2);
   EXPECT_NEAR(lmax, 0.8, 0.2);
+  // Standing, the build shows behind the feet (the toes reach furthest forward): half of a deeper chest, a backpack.
+  auto back = [](const PersonShape& p) {
+    return -static_cast<double>(pedestrianMesh(p, 0, 0, plain()).bounds().min().x());
+  };
+  EXPECT_NEAR(back({1.75, 0.45, 0.34}) - back({1.75, 0.45, 0.30}), 0.02, 0.003);
+  EXPECT_NEAR(back({1.75, 0.45, 0.30, true}) - back({1.75, 0.45, 0.30}), 0.14, 0.01);
   const Eigen::AlignedBox3f c = cyclistMesh(1.78, 1.76, 0.3, plain()).bounds();
   EXPECT_NEAR(c.sizes().x(), 1.78 - 2 * kLabelMargin, 0.08);
   EXPECT_NEAR(c.max().z(), 1.7, 0.12);

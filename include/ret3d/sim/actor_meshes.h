@@ -24,9 +24,16 @@ struct ActorSurfaces {
 // A car whose mesh fills the box length x width x height (minus the margin): body, glazed cabin, wheels, plates.
 TriangleMesh carMesh(CarBody body, double length, double width, double height, const ActorSurfaces& s);
 
-// Body proportions of a person `stature` tall with shoulder breadth `breadth`, walking at gait phase `phase`
-// (radians; one period is two steps) with hip swing `swing` (radians, 0 = standing). Origin between the feet.
-TriangleMesh pedestrianMesh(double stature, double breadth, double phase, double swing, const ActorSurfaces& s);
+// A person's build: `stature` tall, `breadth` across the shoulders (arms included), `depth` from chest to back
+// (clothes included), and whether a backpack is worn.
+struct PersonShape {
+  double stature = 1.75, breadth = 0.45, depth = 0.27;
+  bool backpack = false;
+};
+
+// A person of build `p` walking at gait phase `phase` (radians; one period is two steps) with hip swing `swing`
+// (radians, 0 = standing). Origin between the feet.
+TriangleMesh pedestrianMesh(const PersonShape& p, double phase, double swing, const ActorSurfaces& s);
 
 // A bicycle `length` long with a rider of `stature`, crank at angle `crank` (radians). Origin on the ground at the
 // middle of the wheelbase.

@@ -33,6 +33,8 @@ struct Actor {
   double length = 4, width = 1.7, height = 1.5;
   Eigen::Vector2d box_offset = Eigen::Vector2d::Zero();
   double stature = 1.75, breadth = 0.45, swing_max = 0.4;  // pedestrians and riders
+  double depth = 0.27;          // pedestrians: chest to back, clothes included
+  bool backpack = false;        // pedestrians
   double phase = 0;             // gait or crank angle
   ActorSurfaces surfaces;
 
