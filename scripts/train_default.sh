@@ -15,8 +15,9 @@
 #   6. (sessions 11 and 12; needs ../shared/data or RET3D_SHARED_DATA, skipped with a message without it) two rounds
 #      of 2 epochs each with the 37 unlabelled real KITTI scans taught as background
 #      (config/detector/lwd3d_anchor_selftrain.yaml, `scripts/real_negatives.py` labelling them from the previous
-#      round's detector), refits the car, pedestrian and cyclist score calibration on the relation set
-#      (`scripts/fit_score_calibration.py`) and installs the result with that calibration;
+#      round's detector); (session 13) two more epochs on data made again by the simulator whose pedestrians have a
+#      realistic build (data/sim4_*); refits the car, pedestrian and cyclist score calibration on that simulator's
+#      relation set (`scripts/fit_score_calibration.py`) and installs the result with that calibration;
 #   7. trains IntraRM and InterRM behind the installed detector on the relation set and installs them.
 # The data folders are named for the simulator that made them (data/sim3_*: session 12's, whose pedestrian labels
 # have KITTI's proportions); a folder made by an older simulator is not reused.
@@ -146,12 +147,31 @@ selftrain() {  # round init-model
   model="$OUT/$name.pt"
   echo "real-background round $1: $(tail -n 1 "$OUT/${name}_labels.log"); model $model"
 }
-# The score calibration of config/detector/lwd3d_anchor_selftrain.yaml refitted for the last round's weights: its
-# boxes on the relation set without calibration, a logistic fit per class, the weights written into a copy of the
-# config, and the model saved again with it (the train command once more with --resume: no step, the config stored).
+# Session 13: two more epochs from round 2's weights on data made again by the simulator whose pedestrians have a
+# realistic build (data/sim4_*: same seeds, shoulders 0.48 m across the arms, chests 0.28 m deep, some backpacks),
+# with round 2's real-scan labels.
+SIM4_TRAIN=(--data data/sim4_train_urban data/sim4_train_highway data/real_unl_round2 --data-weights 1 1 12
+  --labels-cover all all all --gt-database data/gtdb/sim4_train.gtdb)
+sim4_round() {  # init-model
+  simulate sim4_train_urban config/sim/urban_street.yaml 32 80 1000
+  simulate sim4_train_highway config/sim/highway.yaml 8 60 2000
+  simulate sim4_relation_urban config/sim/urban_street.yaml 12 80 3000
+  [ -f data/gtdb/sim4_train.gtdb ] || ret3d train gtdb --data data/sim4_train_urban data/sim4_train_highway \
+    --config config/detector/lwd3d_anchor_robust.yaml --out data/gtdb/sim4_train.gtdb >"$OUT/gtdb4.log" 2>&1
+  if [ ! -f "$OUT/sim4.done" ]; then
+    ret3d train detector "${SIM4_TRAIN[@]}" --config config/detector/lwd3d_anchor_selftrain.yaml --init "$1" \
+      --out "$OUT/sim4.pt" --threads 1 --resume >"$OUT/train_sim4.log" 2>&1
+    touch "$OUT/sim4.done"
+  fi
+  model="$OUT/sim4.pt"
+}
+# The score calibration of config/detector/lwd3d_anchor_selftrain.yaml refitted for the last weights: their boxes on
+# the relation set without calibration, a logistic fit per class, the weights written into a copy of the config, and
+# the model saved again with it (the train command once more with --resume: no step, the config stored).
 calibrate() {
   local nocal=$OUT/selftrain_nocal.yaml cal=$OUT/selftrain_calibrated.yaml pred=$OUT/calib_pred
-  [ -f "$OUT/calibrated.done" ] && return
+  local rel=data/sim4_relation_urban
+  [ -f "$OUT/calibrated_sim4.done" ] && return
   python3 - config/detector/lwd3d_anchor_selftrain.yaml "$nocal" <<'PY'
 import sys
 lines = open(sys.argv[1]).read().split("\n")
@@ -167,12 +187,12 @@ for l in lines:
 open(sys.argv[2], "w").write("\n".join(out))
 PY
   # Fitted on the boxes the network scores >= 0.3 (uncalibrated, the candidates are the published boxes).
-  ret3d detect --data data/sim3_relation_urban --detector-model "$model" --detector-config "$nocal" --stages base \
+  ret3d detect --data $rel --detector-model "$model" --detector-config "$nocal" --stages base \
     --score-threshold 0.3 --out "$pred" >"$OUT/calib_detect.log" 2>&1
-  python3 scripts/fit_score_calibration.py --gt data/sim3_relation_urban --pred "$pred" --class Car >"$OUT/calib_car.log"
-  python3 scripts/fit_score_calibration.py --gt data/sim3_relation_urban --pred "$pred" --class Pedestrian --iou 0.5 \
+  python3 scripts/fit_score_calibration.py --gt $rel --pred "$pred" --class Car >"$OUT/calib_car.log"
+  python3 scripts/fit_score_calibration.py --gt $rel --pred "$pred" --class Pedestrian --iou 0.5 \
     --no-shape >"$OUT/calib_ped.log"
-  python3 scripts/fit_score_calibration.py --gt data/sim3_relation_urban --pred "$pred" --class Cyclist --iou 0.5 \
+  python3 scripts/fit_score_calibration.py --gt $rel --pred "$pred" --class Cyclist --iou 0.5 \
     --no-shape >"$OUT/calib_cyc.log"
   python3 - "$nocal" "$cal" "$OUT/calib_car.log" "$OUT/calib_ped.log" "$OUT/calib_cyc.log" <<'PY'
 import re, sys
@@ -188,10 +208,9 @@ for l in open(sys.argv[1]).read().split("\n"):
         out += ["      %s: %s" % (c, w) for c, w in sorted(weights.items())]
 open(sys.argv[2], "w").write("\n".join(out))
 PY
-  ret3d train detector --data data/sim3_train_urban data/sim3_train_highway data/real_unl_round2 --data-weights 1 1 12 \
-    --labels-cover all all all --config "$cal" --init "$OUT/selftrain_1.pt" --gt-database data/gtdb/sim3_train.gtdb \
-    --out "$OUT/selftrain_2.pt" --threads 2 --resume >"$OUT/calib_save.log" 2>&1
-  touch "$OUT/calibrated.done"
+  ret3d train detector "${SIM4_TRAIN[@]}" --config "$cal" --init "$OUT/selftrain_2.pt" --out "$OUT/sim4.pt" \
+    --threads 1 --resume >"$OUT/calib_save.log" 2>&1
+  touch "$OUT/calibrated_sim4.done"
   echo "score calibration: $(tail -n 2 "$OUT/calib_car.log" | head -n 1); $(tail -n 2 "$OUT/calib_ped.log" | head -n 1);" \
     "$(tail -n 2 "$OUT/calib_cyc.log" | head -n 1)"
 }
@@ -199,8 +218,9 @@ if [ -d "$DATA_DIR/kitti_object/unlabeled/velodyne" ] && [ -d "$DATA_DIR/unlabel
    [ -f "$DATA_DIR/kitti_tracking/training/calib/0001.txt" ]; then
   selftrain 1 "$model"
   selftrain 2 "$model"
+  sim4_round "$model"
   calibrate
-  best="real-background rounds 1-2, calibration refitted (not selected on validation: the recipe of the model card)"
+  best="real-background rounds 1-2, the realistic-build round, calibration refitted (the recipe of the model card)"
 else
   echo "train_default.sh: no unlabelled real scans at $DATA_DIR (set RET3D_SHARED_DATA): the real-background rounds" \
        "are skipped; the installed detector is the simulated-only one (as models/lwd3d_sim)" >&2
@@ -208,15 +228,19 @@ fi
 cp "$model" models/lwd3d/detector.pt
 echo "default detector: $model ($best; validation mean 3D AP R40 moderate $best_ap) -> models/lwd3d/detector.pt"
 
-# IntraRM and InterRM behind the installed detector, on the relation set (sequences 0-9 train, 10-11 validation).
-if [ ! -f "$OUT/relation.done" ]; then
-  ret3d train intra --data data/sim3_relation_urban --detector models/lwd3d/detector.pt \
+# IntraRM and InterRM behind the installed detector, on the relation set (sequences 0-9 train, 10-11 validation),
+# taught on the boxes it scores >= 0.3 (more than the 0.5 it publishes: on the simulated validation set, whole
+# pipeline, L2 mAPH 36.35 against 36.07 for the modules trained behind the previous weights; session 13).
+REL=data/sim3_relation_urban
+[ -d data/sim4_relation_urban ] && REL=data/sim4_relation_urban
+if [ ! -f "$OUT/relation_$(basename $REL).done" ]; then
+  ret3d train intra --data $REL --detector models/lwd3d/detector.pt --score-threshold 0.3 \
     --config config/relation/intra_lwd3d_m1.yaml --sequences 0-9 --val-sequences 10-11 --threads 2 \
     --out "$OUT/intra_rm.pt" >"$OUT/train_intra.log" 2>&1
-  ret3d train inter --data data/sim3_relation_urban --detector models/lwd3d/detector.pt --intra-model "$OUT/intra_rm.pt" \
-    --tracker-config config/tracker_lwd3d.yaml --config config/relation/inter_lwd3d.yaml --sequences 0-9 \
-    --val-sequences 10-11 --threads 2 --out "$OUT/inter_rm.pt" >"$OUT/train_inter.log" 2>&1
-  touch "$OUT/relation.done"
+  ret3d train inter --data $REL --detector models/lwd3d/detector.pt --score-threshold 0.3 \
+    --intra-model "$OUT/intra_rm.pt" --tracker-config config/tracker_lwd3d.yaml --config config/relation/inter_lwd3d.yaml \
+    --sequences 0-9 --val-sequences 10-11 --threads 2 --out "$OUT/inter_rm.pt" >"$OUT/train_inter.log" 2>&1
+  touch "$OUT/relation_$(basename $REL).done"
 fi
 cp "$OUT/intra_rm.pt" "$OUT/inter_rm.pt" models/lwd3d/
 echo "relation modules: $(tail -n 1 "$OUT/train_intra.log"); $(tail -n 1 "$OUT/train_inter.log") -> models/lwd3d/"
