@@ -76,7 +76,12 @@ OfflinePipeline::OfflinePipeline(const PipelineConfig& c) : stages_(c.stages) {
         resolveModel(c.detector_model, c.models, "detector.pt", "base", "a detector model", "--detector-model");
     DetectorOptions o = detectorOptionsForModel(path, c.detector_config);
     o.inference.threads = c.threads;
-    if (c.score_threshold >= 0) o.inference.score_threshold = c.score_threshold;
+    if (c.score_threshold >= 0) {
+      o.inference.score_threshold = c.score_threshold;
+    } else if (has(stages_, "track") || has(stages_, "inter")) {  // as the nodelets feed their tracker
+      o.inference.score_threshold =
+          static_cast<float>(pipelineDetectorThreshold(packagePath(), o.inference.score_threshold));
+    }
     if (!c.grid_extent.empty()) {
       o.inference.grid_extent = c.grid_extent;
       try {

@@ -17,5 +17,13 @@ inline constexpr const char* kPipelineTrackerConfig = "config/tracker_lwd3d_pipe
 // (the package is not on ROS_PACKAGE_PATH) or the file is missing.
 std::string defaultTrackerConfig(const std::vector<std::string>& stages, const std::string& package_dir);
 
+// The nodelets' parameter file, relative to the package.
+inline constexpr const char* kPipelineParams = "config/ret3d.yaml";
+
+// The score from which the detector publishes its boxes to the tracker in the pipeline: kPipelineParams'
+// ret3d_detector/score_threshold (lower than the model's own published threshold: the tracker continues its tracks
+// through weak detections and starts them only from its birth scores). `fallback` when the file or key is absent.
+double pipelineDetectorThreshold(const std::string& package_dir, double fallback);
+
 }  // namespace tools
 }  // namespace ret3d

@@ -3,6 +3,7 @@
 #include "tools/tracker_default.h"
 
 #include <filesystem>
+#include <fstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -51,6 +52,26 @@ TEST(TrackerDefault, AMissingPackageIsAClearError) {
     FAIL() << "no error without the file";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("tracker_lwd3d_pipeline.yaml: no such file"), std::string::npos) << e.what();
+  }
+}
+
+// The detector feeds the tracker from config/ret3d.yaml's threshold offline as online; the model's own without it.
+TEST(TrackerDefault, TheDetectorFeedsTheTrackerFromTheNodeletsThreshold) {
+  const double online = pipelineDetectorThreshold(kPackage, 0.9);
+  EXPECT_GT(online, 0.0);
+  EXPECT_LT(online, 0.9);  // read from the file, not the fallback
+  test::TempDir tmp;
+  EXPECT_DOUBLE_EQ(pipelineDetectorThreshold(tmp.path(), 0.5), 0.5);  // no config/ret3d.yaml
+  EXPECT_DOUBLE_EQ(pipelineDetectorThreshold("", 0.5), 0.5);
+  std::filesystem::create_directories(tmp / "config");
+  std::ofstream(tmp / "config/ret3d.yaml") << "ret3d_detector:\n  nms_iou: 0.1\n";
+  EXPECT_DOUBLE_EQ(pipelineDetectorThreshold(tmp.path(), 0.5), 0.5);  // no key
+  std::ofstream(tmp / "config/ret3d.yaml") << "ret3d_detector:\n  score_threshold: 1.5\n";
+  try {
+    pipelineDetectorThreshold(tmp.path(), 0.5);
+    FAIL() << "an out-of-range threshold was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("score_threshold"), std::string::npos) << e.what();
   }
 }
 
