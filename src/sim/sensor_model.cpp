@@ -88,7 +88,8 @@ static SensorModel readSensorModel(YamlReader r) {
   }
   r.finish();
   if (s.elevation_deg.empty()) r.fail("elevation_deg", "no beams given (elevation_deg or elevation_blocks)");
-  if (s.azimuth_resolution_deg <= 0.01 || s.azimuth_resolution_deg > 10) r.fail("azimuth_resolution_deg", "must be in (0.01, 10]");
+  if (s.azimuth_resolution_deg <= 0.01 || s.azimuth_resolution_deg > 10)
+    r.fail("azimuth_resolution_deg", "must be in (0.01, 10]");
   if (s.rotation_rate_hz <= 0) r.fail("rotation_rate_hz", "must be positive");
   if (s.max_range <= s.min_range || s.min_range < 0) r.fail("max_range", "need 0 <= min_range < max_range");
   r.within("dropout", s.dropout, 0, 1);
