@@ -1,13 +1,12 @@
 #include "ret3d/detector/detector_options.h"
 
 #include <algorithm>
-#include <fstream>
 #include <map>
-#include <set>
-#include <sstream>
 #include <stdexcept>
 
 #include <yaml-cpp/yaml.h>
+
+#include "ret3d/core/yaml_reader.h"
 
 namespace ret3d {
 
@@ -92,76 +91,20 @@ BevEncoderOptions DetectorOptions::bevOptions() const {
 
 namespace {
 
-// Reads the keys of one YAML map, refusing any key it was not asked for.
-class MapReader {
- public:
-  MapReader(const YAML::Node& node, std::string path, std::string origin)
-      : node_(node), path_(std::move(path)), origin_(std::move(origin)) {
-    if (node_ && !node_.IsNull() && !node_.IsMap()) fail(path_.empty() ? "top level" : path_, "expected a map");
-  }
-  template <typename T>
-  void get(const std::string& key, T* value) {
-    known_.insert(key);
-    if (!node_ || node_.IsNull() || !node_[key]) return;
-    try {
-      *value = node_[key].as<T>();
-    } catch (const YAML::Exception& e) {
-      fail(full(key), "wrong type or value (" + std::string(e.what()) + ")");
-    }
-  }
-  MapReader child(const std::string& key) {
-    known_.insert(key);
-    return MapReader(node_ && !node_.IsNull() ? node_[key] : YAML::Node(), full(key), origin_);
-  }
-  void finish() const {
-    if (!node_ || node_.IsNull()) return;
-    for (const auto& kv : node_) {
-      const std::string k = kv.first.as<std::string>();
-      if (!known_.count(k)) fail(full(k), "unknown key");
-    }
-  }
-  [[noreturn]] void fail(const std::string& key, const std::string& msg) const {
-    throw std::runtime_error(origin_ + ": " + key + ": " + msg);
-  }
-  std::string full(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
-
- private:
-  YAML::Node node_;
-  std::string path_, origin_;
-  std::set<std::string> known_;
-};
-
-// A list of class names under `key`, e.g. classes: [Car, Pedestrian].
-void readClasses(MapReader& r, const std::string& key, std::vector<ObjectClass>* out) {
-  std::vector<std::string> names;
-  for (ObjectClass c : *out) names.push_back(className(c));
-  r.get(key, &names);
-  out->clear();
-  for (const auto& name : names) {
-    const auto c = classFromName(name);
-    if (!c) r.fail(r.full(key), "unknown class '" + name + "' (Car, Pedestrian, Cyclist)");
-    out->push_back(*c);
-  }
-}
-
-// A map from class names to values under `key`, e.g. centroid: {Pedestrian: 0.1} or score_calibration: {Car: [...]}.
+// A map by class name, e.g. centroid: {Pedestrian: 0.1}, ordered by class name: gt_sample_counts draws its classes in
+// this order, as it always has.
 template <typename V>
-void readClassValues(MapReader& r, const std::string& key, std::vector<std::pair<ObjectClass, V>>* out) {
-  std::map<std::string, V> values;
-  for (const auto& [c, v] : *out) values[className(c)] = v;
-  r.get(key, &values);
-  out->clear();
-  for (const auto& [name, v] : values) {
-    const auto c = classFromName(name);
-    if (!c) r.fail(r.full(key), "unknown class '" + name + "' (Car, Pedestrian, Cyclist)");
-    out->emplace_back(*c, v);
-  }
+void readClassValues(YamlReader& r, const std::string& key, std::vector<std::pair<ObjectClass, V>>* out) {
+  if (!r.getClassValues(key, out)) return;
+  std::stable_sort(out->begin(), out->end(), [](const auto& a, const auto& b) {
+    return std::string(className(a.first)) < className(b.first);
+  });
 }
 
-void readModel(MapReader r, ModelConfig* m) {
-  readClasses(r, "classes", &m->classes);
+void readModel(YamlReader r, ModelConfig* m) {
+  r.getClasses("classes", &m->classes);
   {
-    MapReader g = r.child("bev");
+    YamlReader g = r.child("bev");
     g.get("x_min", &m->geometry.x_min);
     g.get("x_max", &m->geometry.x_max);
     g.get("y_min", &m->geometry.y_min);
@@ -174,7 +117,7 @@ void readModel(MapReader r, ModelConfig* m) {
     g.finish();
   }
   {
-    MapReader n = r.child("network");
+    YamlReader n = r.child("network");
     n.get("stem_channels", &m->network.stem_channels);
     n.get("stage_channels", &m->network.stage_channels);
     n.get("stage_blocks", &m->network.stage_blocks);
@@ -184,13 +127,9 @@ void readModel(MapReader r, ModelConfig* m) {
     n.get("head_channels", &m->network.head_channels);
     n.finish();
   }
-  std::string head = headTypeName(m->head);
-  r.get("head", &head);
-  if (head == "anchor") m->head = HeadType::Anchor;
-  else if (head == "center") m->head = HeadType::Center;
-  else r.fail(r.full("head"), "must be 'anchor' or 'center', not '" + head + "'");
+  r.getChoice("head", &m->head, {{"anchor", HeadType::Anchor}, {"center", HeadType::Center}});
   {
-    MapReader a = r.child("anchor");
+    YamlReader a = r.child("anchor");
     a.get("strides", &m->anchor.strides);
     a.get("anchors_per_class", &m->anchor.anchors_per_class);
     a.get("scale_fraction", &m->anchor.scale_fraction);
@@ -199,7 +138,7 @@ void readModel(MapReader r, ModelConfig* m) {
     a.finish();
   }
   {
-    MapReader c = r.child("center");
+    YamlReader c = r.child("center");
     c.get("stride", &m->center.stride);
     c.get("gaussian_overlap", &m->center.gaussian_overlap);
     c.get("min_radius", &m->center.min_radius);
@@ -208,14 +147,11 @@ void readModel(MapReader r, ModelConfig* m) {
   r.finish();
 }
 
-void readInference(MapReader r, InferenceOptions* o) {
+void readInference(YamlReader r, InferenceOptions* o) {
   r.get("model_path", &o->model_path);
   r.get("threads", &o->threads);
-  r.get("score_threshold", &o->score_threshold);
-  r.get("candidate_threshold", &o->candidate_threshold);
-  for (const auto& [key, v] : {std::pair<const char*, float>{"score_threshold", o->score_threshold},
-                                {"candidate_threshold", o->candidate_threshold}})
-    if (!(v >= 0 && v <= 1)) r.fail(r.full(key), "must lie in [0, 1]");
+  r.get("score_threshold", &o->score_threshold, 0, 1);
+  r.get("candidate_threshold", &o->candidate_threshold, 0, 1);
   r.get("max_candidates", &o->max_candidates);
   r.get("max_detections", &o->max_detections);
   r.get("nms_iou", &o->nms_iou);
@@ -223,11 +159,11 @@ void readInference(MapReader r, InferenceOptions* o) {
   r.get("iou_score_power", &o->iou_score_power);
   readClassValues(r, "heading_from_velocity", &o->heading_from_velocity);
   for (const auto& [c, speed] : o->heading_from_velocity)
-    if (!(speed >= 0)) r.fail(r.full("heading_from_velocity"), "speeds must be >= 0 m/s");
+    r.within(std::string("heading_from_velocity.") + className(c), speed, 0, YamlReader::kNoLimit);  // m/s
   r.get("grid_extent", &o->grid_extent);  // checked against the model once it is read (detectorOptionsFromYaml)
   {
-    MapReader p = r.child("point_refine");
-    readClasses(p, "faces", &o->point_refine.faces);
+    YamlReader p = r.child("point_refine");
+    p.getClasses("faces", &o->point_refine.faces);
     readClassValues(p, "centroid", &o->point_refine.centroid);
     p.get("centroid_margin", &o->point_refine.centroid_margin);
     p.get("centroid_height", &o->point_refine.centroid_height);
@@ -250,17 +186,17 @@ void readInference(MapReader r, InferenceOptions* o) {
     try {
       o->point_refine.validate();
     } catch (const std::invalid_argument& e) {
-      r.fail(r.full("point_refine"), e.what());
+      r.fail("point_refine", e.what());
     }
   }
   r.finish();
-  if (!(o->iou_score_power >= 0 && o->iou_score_power <= 1)) r.fail(r.full("iou_score_power"), "must lie in [0, 1]");
-  if (!(o->nms_voting_iou >= 0 && o->nms_voting_iou <= 1)) r.fail(r.full("nms_voting_iou"), "must lie in [0, 1]");
-  if (o->threads < 1) r.fail(r.full("threads"), "must be >= 1");
+  r.within("iou_score_power", o->iou_score_power, 0, 1);
+  r.within("nms_voting_iou", o->nms_voting_iou, 0, 1);
+  r.within("threads", o->threads, 1, YamlReader::kNoLimit);
 }
 
 // The sim-to-real augmentation keys (SensorAugmentOptions), directly under `train:`.
-void readSensorAugment(MapReader& r, SensorAugmentOptions* a) {
+void readSensorAugment(YamlReader& r, SensorAugmentOptions* a) {
   r.get("ray_drop_min", &a->ray_drop_min);
   r.get("ray_drop_max", &a->ray_drop_max);
   r.get("ray_drop_far", &a->ray_drop_far);
@@ -284,11 +220,6 @@ void readSensorAugment(MapReader& r, SensorAugmentOptions* a) {
   r.get("gt_database", &a->gt_database);
   readClassValues(r, "gt_sample_counts", &a->gt_sample_counts);
   r.get("gt_sample_margin", &a->gt_sample_margin);
-  auto within = [&](const char* key, double v, double lo, double hi) {
-    if (!(v >= lo && v <= hi))
-      r.fail(r.full(key), "must lie in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " +
-                              std::to_string(v));
-  };
   for (const auto& [key, v] : {std::pair<const char*, double>{"ray_drop_min", a->ray_drop_min},
                                {"ray_drop_max", a->ray_drop_max},
                                {"ray_drop_far", a->ray_drop_far},
@@ -299,25 +230,24 @@ void readSensorAugment(MapReader& r, SensorAugmentOptions* a) {
                                {"intensity_constant_probability", a->intensity_constant_probability},
                                {"intensity_constant_value", a->intensity_constant_value},
                                {"previous_dropout_probability", a->previous_dropout_probability}})
-    within(key, v, 0.0, 1.0);
-  if (a->ray_drop_min > a->ray_drop_max) r.fail(r.full("ray_drop_min"), "must not exceed ray_drop_max");
-  if (a->min_box_points < 0) r.fail(r.full("min_box_points"), "must be >= 0");
-  if (a->beam_subsample_keep_every < 2) r.fail(r.full("beam_subsample_keep_every"), "must be >= 2");
+    r.within(key, v, 0.0, 1.0);
+  if (a->ray_drop_min > a->ray_drop_max) r.fail("ray_drop_min", "must not exceed ray_drop_max");
+  r.within("min_box_points", a->min_box_points, 0, YamlReader::kNoLimit);
+  r.within("beam_subsample_keep_every", a->beam_subsample_keep_every, 2, YamlReader::kNoLimit);
   if (a->beam_subsample_probability > 0 && a->beam_sensor.empty())
-    r.fail(r.full("beam_sensor"), "a sensor YAML is needed for beam_subsample_probability > 0");
-  within("intensity_scale_min", a->intensity_scale_min, 0.0, 10.0);
-  within("intensity_scale_max", a->intensity_scale_max, a->intensity_scale_min, 10.0);
-  within("intensity_gamma_min", a->intensity_gamma_min, 0.1, 10.0);
-  within("intensity_gamma_max", a->intensity_gamma_max, a->intensity_gamma_min, 10.0);
-  within("intensity_noise_sigma", a->intensity_noise_sigma, 0.0, 0.5);
-  within("pose_z_range", a->pose_z_range, 0.0, 1.0);
-  within("pose_tilt_deg", a->pose_tilt_deg, 0.0, 10.0);
-  within("gt_sample_margin", a->gt_sample_margin, 0.0, 5.0);
-  for (const auto& [c, n] : a->gt_sample_counts)
-    if (n < 0 || n > 100) r.fail(r.full("gt_sample_counts"), std::string(className(c)) + ": must lie in [0, 100]");
+    r.fail("beam_sensor", "a sensor YAML is needed for beam_subsample_probability > 0");
+  r.within("intensity_scale_min", a->intensity_scale_min, 0.0, 10.0);
+  r.within("intensity_scale_max", a->intensity_scale_max, a->intensity_scale_min, 10.0);
+  r.within("intensity_gamma_min", a->intensity_gamma_min, 0.1, 10.0);
+  r.within("intensity_gamma_max", a->intensity_gamma_max, a->intensity_gamma_min, 10.0);
+  r.within("intensity_noise_sigma", a->intensity_noise_sigma, 0.0, 0.5);
+  r.within("pose_z_range", a->pose_z_range, 0.0, 1.0);
+  r.within("pose_tilt_deg", a->pose_tilt_deg, 0.0, 10.0);
+  r.within("gt_sample_margin", a->gt_sample_margin, 0.0, 5.0);
+  for (const auto& [c, n] : a->gt_sample_counts) r.within(std::string("gt_sample_counts.") + className(c), n, 0, 100);
 }
 
-void readTrain(MapReader r, TrainOptions* t) {
+void readTrain(YamlReader r, TrainOptions* t) {
   r.get("epochs", &t->epochs);
   r.get("batch_size", &t->batch_size);
   r.get("learning_rate", &t->learning_rate);
@@ -343,16 +273,8 @@ void readTrain(MapReader r, TrainOptions* t) {
   r.get("loss_weight_iou", &t->loss_weight_iou);
   readSensorAugment(r, &t->sensor_augment);
   r.finish();
-  if (t->epochs < 1) r.fail(r.full("epochs"), "must be >= 1");
-  if (t->batch_size < 1) r.fail(r.full("batch_size"), "must be >= 1");
-}
-
-YAML::Node parse(const std::string& text, const std::string& origin) {
-  try {
-    return YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error(origin + ": line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
-  }
+  r.within("epochs", t->epochs, 1, YamlReader::kNoLimit);
+  r.within("batch_size", t->batch_size, 1, YamlReader::kNoLimit);
 }
 
 void flatten(const YAML::Node& n, const std::string& prefix, std::map<std::string, std::string>* out) {
@@ -367,9 +289,8 @@ void flatten(const YAML::Node& n, const std::string& prefix, std::map<std::strin
 
 }  // namespace
 
-static DetectorOptions readDetectorOptions(const YAML::Node& root, const std::string& origin) {
+static DetectorOptions readDetectorOptions(YamlReader r) {
   DetectorOptions o;
-  MapReader r(root, "", origin);
   readModel(r.child("model"), &o.model);
   readInference(r.child("inference"), &o.inference);
   readTrain(r.child("train"), &o.train);
@@ -377,33 +298,21 @@ static DetectorOptions readDetectorOptions(const YAML::Node& root, const std::st
   try {
     o.model.validate();
   } catch (const std::invalid_argument& e) {
-    throw std::runtime_error(origin + ": " + e.what());
+    r.fail("", e.what());
   }
   try {
     o.validateGridExtent();
   } catch (const std::invalid_argument& e) {
-    throw std::runtime_error(origin + ": inference.grid_extent: " + e.what());
+    r.fail("inference.grid_extent", e.what());
   }
   return o;
 }
 
-// A value of the wrong type (yaml-cpp's BadConversion, e.g. a list where a name belongs) is refused naming the file.
 DetectorOptions detectorOptionsFromYaml(const std::string& yaml_text, const std::string& origin) {
-  const YAML::Node root = parse(yaml_text, origin);
-  try {
-    return readDetectorOptions(root, origin);
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error(origin + ": " + e.what());
-  }
+  return readDetectorOptions(YamlReader::parse(yaml_text, origin));
 }
 
-DetectorOptions loadDetectorOptions(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path + ": cannot open detector config");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return detectorOptionsFromYaml(ss.str(), path);
-}
+DetectorOptions loadDetectorOptions(const std::string& path) { return readDetectorOptions(YamlReader::load(path)); }
 
 std::string modelConfigToYaml(const ModelConfig& m) {
   YAML::Emitter e;
@@ -448,7 +357,7 @@ std::string modelConfigToYaml(const ModelConfig& m) {
 
 ModelConfig modelConfigFromYaml(const std::string& yaml_text, const std::string& origin) {
   ModelConfig m;
-  readModel(MapReader(parse(yaml_text, origin), "model", origin), &m);
+  readModel(YamlReader::parse(yaml_text, origin, "model"), &m);
   return m;
 }
 

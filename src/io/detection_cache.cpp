@@ -24,9 +24,9 @@ void putString(std::ostream& out, const std::string& s) {
   out.write(s.data(), static_cast<std::streamsize>(s.size()));
 }
 
-class Reader {
+class BinaryReader {
  public:
-  Reader(std::istream& in, const std::string& path) : in_(in), path_(path) {}
+  BinaryReader(std::istream& in, const std::string& path) : in_(in), path_(path) {}
   template <class T>
   T get() {
     T v{};
@@ -97,7 +97,7 @@ void writeDetectionCache(const std::string& path, const std::string& key, const 
 bool readDetectionCache(const std::string& path, const std::string& key, SequenceDetections* detections) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return false;
-  Reader r(in, path);
+  BinaryReader r(in, path);
   char magic[sizeof(kMagic)];
   in.read(magic, sizeof(magic));
   if (!in || std::memcmp(magic, kMagic, sizeof(kMagic)) != 0)

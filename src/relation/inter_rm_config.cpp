@@ -1,28 +1,14 @@
 // InterRM configuration from YAML (config/relation/inter_rm.yaml): one loader, loud on typos.
-#include <fstream>
-#include <set>
-#include <sstream>
 #include <stdexcept>
 
 #include <yaml-cpp/yaml.h>
 
-#include "config_reader.h"
+#include "config_sections.h"
 
 #include "ret3d/relation/inter_rm.h"
 
 namespace ret3d {
 namespace relation {
-
-namespace {
-
-InterPositionalEncoding parsePe(const std::string& s, const detail::ConfigReader& r) {
-  if (s == "implicit") return InterPositionalEncoding::Implicit;
-  if (s == "temporal") return InterPositionalEncoding::Temporal;
-  if (s == "spatial") return InterPositionalEncoding::Spatial;
-  r.fail("'model.positional_encoding' is '" + s + "' (allowed: implicit, temporal, spatial)");
-}
-
-}  // namespace
 
 const char* positionalEncodingName(InterPositionalEncoding pe) {
   switch (pe) {
@@ -50,51 +36,35 @@ void InterRMTrainConfig::validate() const {
   if (sequences_per_batch < 1) bad("sequences_per_batch must be >= 1");
   if (epochs < 0) bad("epochs must be >= 0");
   if (!(smooth_l1_beta > 0)) bad("smooth_l1_beta must be > 0");
-  for (double v : reg_min_iou)
-    if (!(v > 0 && v <= 1)) bad("reg_min_iou values must be in (0, 1]");
+  for (ObjectClass k : kDetectedClasses)
+    if (!(reg_min_iou.at(k) > 0 && reg_min_iou.at(k) <= 1)) bad("reg_min_iou values must be in (0, 1]");
 }
 
 InterRMConfig parseInterRMConfig(const std::string& yaml_text, const std::string& source) {
-  const detail::ConfigReader r("InterRM", source);
-  const YAML::Node root = r.load(yaml_text);
-  InterRMConfig c;
-  if (root.IsNull()) return c;
-  r.checkKeys(root, {"model", "train"}, "<top>");
-  if (const YAML::Node m = root["model"]) {
-    r.checkKeys(m, {"c_enc", "heads", "ffn_expansion", "positional_encoding", "max_history", "regress_size"}, "model");
-    r.read(m, "regress_size", &c.model.regress_size, "model");
-    r.read(m, "c_enc", &c.model.c_enc, "model");
-    r.read(m, "heads", &c.model.heads, "model");
-    r.read(m, "ffn_expansion", &c.model.ffn_expansion, "model");
-    std::string pe = positionalEncodingName(c.model.positional_encoding);
-    r.read(m, "positional_encoding", &pe, "model");
-    c.model.positional_encoding = parsePe(pe, r);
-    r.read(m, "max_history", &c.model.max_history, "model");
-  }
-  if (const YAML::Node t = root["train"]) {
-    r.checkKeys(t,
-              {"lr", "weight_decay", "sequences_per_batch", "epochs", "smooth_l1_beta", "reg_min_iou", "augment_flip",
-               "seed"}, "train");
-    r.read(t, "lr", &c.train.lr, "train");
-    r.read(t, "weight_decay", &c.train.weight_decay, "train");
-    r.read(t, "sequences_per_batch", &c.train.sequences_per_batch, "train");
-    r.read(t, "epochs", &c.train.epochs, "train");
-    r.read(t, "smooth_l1_beta", &c.train.smooth_l1_beta, "train");
-    r.read(t, "augment_flip", &c.train.augment_flip, "train");
-    r.read(t, "seed", &c.train.seed, "train");
-    r.readPerClass(t, "reg_min_iou", &c.train.reg_min_iou, "train");
-  }
-  try {
-    c.model.validate();
-    c.train.validate();
-  } catch (const std::invalid_argument& e) {
-    r.fail(e.what());
-  }
-  return c;
+  return detail::readConfigSections<InterRMConfig>(
+      "InterRM", yaml_text, source, [](YamlReader& m, YamlReader& t, InterRMConfig* c) {
+        m.get("regress_size", &c->model.regress_size);
+        m.get("c_enc", &c->model.c_enc);
+        m.get("heads", &c->model.heads);
+        m.get("ffn_expansion", &c->model.ffn_expansion);
+        m.getChoice("positional_encoding", &c->model.positional_encoding,
+                    {{"implicit", InterPositionalEncoding::Implicit},
+                     {"temporal", InterPositionalEncoding::Temporal},
+                     {"spatial", InterPositionalEncoding::Spatial}});
+        m.get("max_history", &c->model.max_history);
+        t.get("lr", &c->train.lr);
+        t.get("weight_decay", &c->train.weight_decay);
+        t.get("sequences_per_batch", &c->train.sequences_per_batch);
+        t.get("epochs", &c->train.epochs);
+        t.get("smooth_l1_beta", &c->train.smooth_l1_beta);
+        t.get("augment_flip", &c->train.augment_flip);
+        t.get("seed", &c->train.seed);
+        t.getPerClass("reg_min_iou", &c->train.reg_min_iou);
+      });
 }
 
 InterRMConfig loadInterRMConfig(const std::string& path) {
-  return parseInterRMConfig(detail::readConfigFile("InterRM", path), path);
+  return parseInterRMConfig(readConfigText(path, "InterRM config " + path), path);
 }
 
 std::string toYaml(const InterRMConfig& c) {
@@ -116,7 +86,7 @@ std::string toYaml(const InterRMConfig& c) {
   e << YAML::Key << "smooth_l1_beta" << YAML::Value << c.train.smooth_l1_beta;
   e << YAML::Key << "reg_min_iou" << YAML::Value << YAML::BeginMap;
   for (ObjectClass k : kDetectedClasses)
-    e << YAML::Key << className(k) << YAML::Value << c.train.reg_min_iou[static_cast<int>(k) - 1];
+    e << YAML::Key << className(k) << YAML::Value << c.train.reg_min_iou.at(k);
   e << YAML::EndMap;
   e << YAML::Key << "augment_flip" << YAML::Value << c.train.augment_flip;
   e << YAML::Key << "seed" << YAML::Value << c.train.seed;

@@ -1,14 +1,11 @@
 #include "ret3d/relation/intra_rm_config.h"
 
 #include <cmath>
-#include <fstream>
-#include <set>
-#include <sstream>
 #include <stdexcept>
 
 #include <yaml-cpp/yaml.h>
 
-#include "config_reader.h"
+#include "config_sections.h"
 
 #include "ret3d/core/types.h"
 
@@ -40,50 +37,33 @@ void IntraRMTrainConfig::validate() const {
 }
 
 IntraRMConfig parseIntraRMConfig(const std::string& yaml_text, const std::string& source) {
-  const detail::ConfigReader r("IntraRM", source);
-  const YAML::Node root = r.load(yaml_text);
-  IntraRMConfig c;
-  if (root.IsNull()) return c;
-  r.checkKeys(root, {"model", "train"}, "<top>");
-  if (const YAML::Node m = root["model"]) {
-    r.checkKeys(m, {"feature_dim", "hidden", "rounds", "radius", "use_edges", "head_hidden", "refine_boxes"}, "model");
-    r.read(m, "feature_dim", &c.model.feature_dim, "model");
-    r.read(m, "hidden", &c.model.hidden, "model");
-    r.read(m, "rounds", &c.model.rounds, "model");
-    r.read(m, "radius", &c.model.radius, "model");
-    r.read(m, "use_edges", &c.model.use_edges, "model");
-    r.read(m, "head_hidden", &c.model.head_hidden, "model");
-    r.read(m, "refine_boxes", &c.model.refine_boxes, "model");
-  }
-  if (const YAML::Node t = root["train"]) {
-    r.checkKeys(t,
-              {"lr", "weight_decay", "frames_per_batch", "epochs", "loc_weight", "dir_weight", "focal_alpha",
-               "focal_gamma", "cls_pos_iou", "reg_min_iou", "augment_flip", "augment_rotation", "seed"}, "train");
-    r.read(t, "lr", &c.train.lr, "train");
-    r.read(t, "weight_decay", &c.train.weight_decay, "train");
-    r.read(t, "frames_per_batch", &c.train.frames_per_batch, "train");
-    r.read(t, "epochs", &c.train.epochs, "train");
-    r.read(t, "loc_weight", &c.train.loc_weight, "train");
-    r.read(t, "dir_weight", &c.train.dir_weight, "train");
-    r.read(t, "focal_alpha", &c.train.focal_alpha, "train");
-    r.read(t, "focal_gamma", &c.train.focal_gamma, "train");
-    r.readPerClass(t, "cls_pos_iou", &c.train.cls_pos_iou, "train");
-    r.readPerClass(t, "reg_min_iou", &c.train.reg_min_iou, "train");
-    r.read(t, "augment_flip", &c.train.augment_flip, "train");
-    r.read(t, "augment_rotation", &c.train.augment_rotation, "train");
-    r.read(t, "seed", &c.train.seed, "train");
-  }
-  try {
-    c.model.validate();
-    c.train.validate();
-  } catch (const std::invalid_argument& e) {
-    r.fail(e.what());
-  }
-  return c;
+  return detail::readConfigSections<IntraRMConfig>(
+      "IntraRM", yaml_text, source, [](YamlReader& m, YamlReader& t, IntraRMConfig* c) {
+        m.get("feature_dim", &c->model.feature_dim);
+        m.get("hidden", &c->model.hidden);
+        m.get("rounds", &c->model.rounds);
+        m.get("radius", &c->model.radius);
+        m.get("use_edges", &c->model.use_edges);
+        m.get("head_hidden", &c->model.head_hidden);
+        m.get("refine_boxes", &c->model.refine_boxes);
+        t.get("lr", &c->train.lr);
+        t.get("weight_decay", &c->train.weight_decay);
+        t.get("frames_per_batch", &c->train.frames_per_batch);
+        t.get("epochs", &c->train.epochs);
+        t.get("loc_weight", &c->train.loc_weight);
+        t.get("dir_weight", &c->train.dir_weight);
+        t.get("focal_alpha", &c->train.focal_alpha);
+        t.get("focal_gamma", &c->train.focal_gamma);
+        t.getPerClass("cls_pos_iou", &c->train.cls_pos_iou);
+        t.getPerClass("reg_min_iou", &c->train.reg_min_iou);
+        t.get("augment_flip", &c->train.augment_flip);
+        t.get("augment_rotation", &c->train.augment_rotation);
+        t.get("seed", &c->train.seed);
+      });
 }
 
 IntraRMConfig loadIntraRMConfig(const std::string& path) {
-  return parseIntraRMConfig(detail::readConfigFile("IntraRM", path), path);
+  return parseIntraRMConfig(readConfigText(path, "IntraRM config " + path), path);
 }
 
 std::string toYaml(const IntraRMConfig& c) {
@@ -98,7 +78,7 @@ std::string toYaml(const IntraRMConfig& c) {
   e << YAML::Key << "head_hidden" << YAML::Value << c.model.head_hidden;
   e << YAML::Key << "refine_boxes" << YAML::Value << c.model.refine_boxes;
   e << YAML::EndMap;
-  auto per_class = [&](const char* key, const PerClass& v) {
+  auto per_class = [&](const char* key, const PerClass<double>& v) {
     e << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginMap;
     for (int k = 0; k < 3; ++k) e << YAML::Key << className(kDetectedClasses[k]) << YAML::Value << v[k];
     e << YAML::EndMap;

@@ -1,12 +1,10 @@
 #include "ret3d/tracking/tracker_options.h"
 
 #include <cmath>
-#include <fstream>
-#include <optional>
 #include <sstream>
 #include <stdexcept>
 
-#include <yaml-cpp/yaml.h>
+#include "ret3d/core/yaml_reader.h"
 
 namespace ret3d {
 namespace {
@@ -21,84 +19,36 @@ std::string str(double v) {
   return os.str();
 }
 
-// The scalar text of a node, for error messages.
-std::string text(const YAML::Node& n) {
-  if (n.IsScalar()) return "'" + n.Scalar() + "'";
-  std::ostringstream os;
-  os << YAML::Dump(n);
-  return os.str();
-}
-
-// The scalar as T, or an error naming the parameter and what it must be.
-template <typename T>
-T read(const YAML::Node& n, const std::string& name, const char* what) {
-  if (!n.IsScalar()) invalid(name, text(n), what);
-  try {
-    return n.as<T>();
-  } catch (const YAML::Exception&) {
-    invalid(name, text(n), what);
-  }
-}
-double readDouble(const YAML::Node& n, const std::string& name) { return read<double>(n, name, "a number"); }
-int readInt(const YAML::Node& n, const std::string& name) { return read<int>(n, name, "an integer"); }
-bool readBool(const YAML::Node& n, const std::string& name) { return read<bool>(n, name, "true or false"); }
-
-void readPerClass(const YAML::Node& n, const std::string& name, PerClass<double>& out) {
-  if (!n.IsMap()) invalid(name, text(n), "a map with keys Car, Pedestrian, Cyclist");
-  for (const auto& kv : n) {
-    const std::string key = kv.first.as<std::string>();
-    const std::optional<ObjectClass> c = classFromName(key);
-    if (!c) invalid(name + "." + key, text(kv.second), "class keys Car, Pedestrian, Cyclist only");
-    out.at(*c) = readDouble(kv.second, name + "." + key);
-  }
-}
-
-TrackerOptions fromNode(const YAML::Node& root) {
+// Value errors are std::invalid_argument, as validate() throws them; a file that cannot be read or parsed is a
+// std::runtime_error (a ConfigError).
+TrackerOptions readTrackerOptions(YamlReader r) {
   TrackerOptions o;
-  if (!root || root.IsNull()) return o;
-  if (!root.IsMap()) invalid("(document)", text(root), "a map of tracker options");
-  for (const auto& kv : root) {
-    const std::string key = kv.first.as<std::string>();
-    const YAML::Node& v = kv.second;
-    if (key == "assignment") {
-      const std::string s = v.IsScalar() ? v.Scalar() : std::string();
-      if (s == "greedy") {
-        o.assignment = AssignmentMethod::Greedy;
-      } else if (s == "hungarian") {
-        o.assignment = AssignmentMethod::Hungarian;
-      } else {
-        invalid(key, text(v), "greedy or hungarian");
-      }
-    } else if (key == "gate") {
-      readPerClass(v, key, o.gate);
-    } else if (key == "max_speed") {
-      readPerClass(v, key, o.max_speed);
-    } else if (key == "score_threshold") {
-      o.score_threshold = readDouble(v, key);
-    } else if (key == "birth_score") {
-      if (v.IsScalar()) {
-        const double b = readDouble(v, key);
-        o.birth_score = {b, b, b};
-      } else {
-        readPerClass(v, key, o.birth_score);
-      }
-    } else if (key == "max_age") {
-      o.max_age = readInt(v, key);
-    } else if (key == "max_time_gap") {
-      o.max_time_gap = readDouble(v, key);
-    } else if (key == "use_detection_velocity") {
-      o.use_detection_velocity = readBool(v, key);
-    } else if (key == "velocity_window") {
-      o.velocity_window = readInt(v, key);
-    } else if (key == "history_length") {
-      o.history_length = readInt(v, key);
-    } else {
-      invalid(key, text(v),
-              "keys assignment, gate, max_speed, score_threshold, birth_score, max_age, max_time_gap, "
-              "use_detection_velocity, velocity_window, history_length (unknown key)");
+  try {
+    r.getChoice("assignment", &o.assignment,
+                {{"greedy", AssignmentMethod::Greedy}, {"hungarian", AssignmentMethod::Hungarian}});
+    r.getPerClass("gate", &o.gate);
+    r.getPerClass("max_speed", &o.max_speed);
+    r.get("score_threshold", &o.score_threshold);
+    double one_for_all = 0;
+    if (r.isMap("birth_score")) {
+      r.getPerClass("birth_score", &o.birth_score);
+    } else if (r.get("birth_score", &one_for_all)) {
+      o.birth_score = {one_for_all, one_for_all, one_for_all};
     }
+    r.get("max_age", &o.max_age);
+    r.get("max_time_gap", &o.max_time_gap);
+    r.get("use_detection_velocity", &o.use_detection_velocity);
+    r.get("velocity_window", &o.velocity_window);
+    r.get("history_length", &o.history_length);
+    r.finish();
+    try {
+      validate(o);
+    } catch (const std::invalid_argument& e) {
+      r.fail("", e.what());
+    }
+  } catch (const ConfigError& e) {
+    throw std::invalid_argument(e.what());
   }
-  validate(o);
   return o;
 }
 
@@ -127,35 +77,11 @@ void validate(const TrackerOptions& o) {
 }
 
 TrackerOptions parseTrackerOptions(const std::string& yaml_text) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error(std::string("tracker options: YAML parse error: ") + e.what());
-  }
-  try {
-    return fromNode(root);
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error(std::string("tracker options: ") + e.what());
-  }
+  return readTrackerOptions(YamlReader::parse(yaml_text, "tracker options"));
 }
 
 TrackerOptions loadTrackerOptions(const std::string& yaml_path) {
-  std::ifstream in(yaml_path);
-  if (!in) throw std::runtime_error("tracker options: cannot read " + yaml_path);
-  YAML::Node root;
-  try {
-    root = YAML::Load(in);
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error(yaml_path + ": YAML parse error: " + e.what());
-  }
-  try {
-    return fromNode(root);
-  } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(yaml_path + ": " + e.what());
-  } catch (const YAML::Exception& e) {  // a value of the wrong type, e.g. a list where a name belongs
-    throw std::runtime_error(yaml_path + ": " + e.what());
-  }
+  return readTrackerOptions(YamlReader::load(yaml_path));
 }
 
 }  // namespace ret3d

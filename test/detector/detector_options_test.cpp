@@ -43,7 +43,7 @@ TEST(DetectorOptions, MistakesAreRefusedNamingTheFileAndKey) {
     FAIL() << "a typo was accepted";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("model.bev.resolutoin: unknown key"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("key 'model.bev.resolutoin': unknown key"), std::string::npos) << e.what();
   }
   EXPECT_THROW(detectorOptionsFromYaml("model: {head: yolo}"), std::runtime_error);
   EXPECT_THROW(detectorOptionsFromYaml("model: {classes: [Car, Truck]}"), std::runtime_error);

@@ -81,20 +81,20 @@ TEST(TrackerOptions, InvalidValuesNameParameterValueAndAllowed) {
       {"assignment: optimal", "assignment", "optimal", "greedy or hungarian"},
       {"gate: {Car: -1}", "gate.Car", "-1", "> 0"},
       {"gate: {Pedestrian: 0}", "gate.Pedestrian", "0", "> 0"},
-      {"gate: {Truck: 1.0}", "gate.Truck", "1", "Car, Pedestrian, Cyclist"},
+      {"gate: {Truck: 1.0}", "gate.Truck", "unknown class", "Car, Pedestrian, Cyclist"},
       {"gate: 1.0", "gate", "1.0", "a map"},
       {"max_speed: {Cyclist: -3}", "max_speed.Cyclist", "-3", ">= 0"},
       {"score_threshold: abc", "score_threshold", "abc", "a number"},
       {"birth_score: .nan", "birth_score.Car", "nan", "finite"},  // one value for all classes
       {"birth_score: {Cyclist: .nan}", "birth_score.Cyclist", "nan", "finite"},
-      {"birth_score: {Truck: 0.5}", "birth_score.Truck", "0.5", "class keys"},
+      {"birth_score: {Truck: 0.5}", "birth_score.Truck", "unknown class", "Car, Pedestrian, Cyclist"},
       {"max_age: -1", "max_age", "-1", "[0, 1000]"},
       {"max_age: 2.5", "max_age", "2.5", "an integer"},
       {"max_time_gap: 0", "max_time_gap", "0", "> 0"},
       {"use_detection_velocity: maybe", "use_detection_velocity", "maybe", "true or false"},
       {"velocity_window: 1", "velocity_window", "1", "[2, 1000]"},
       {"history_length: 0", "history_length", "0", "[1, 100000]"},
-      {"histroy_length: 20", "histroy_length", "20", "unknown key"},
+      {"histroy_length: 20", "histroy_length", "unknown key", "history_length"},  // the known keys
   };
   for (const Case& c : cases) {
     const std::string msg = errorOf(c.yaml);

@@ -16,13 +16,13 @@
 // Variable-length sequences are batched with padding and a key padding mask; a padded entry never changes the output.
 #pragma once
 
-#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "ret3d/core/per_class.h"
 #include "ret3d/core/types.h"
 
 namespace ret3d {
@@ -55,7 +55,7 @@ struct InterRMTrainConfig {
   double smooth_l1_beta = 0.1;  // smooth-L1 transition point (residual units: m, log-ratio, rad)
   // The current box is regressed towards its class-aware best BEV-IoU ground truth when the IoU reaches this
   // (Car, Pedestrian, Cyclist): the assignment IntraRM uses.
-  std::array<double, 3> reg_min_iou{{0.5, 0.3, 0.3}};
+  PerClass<double> reg_min_iou{0.5, 0.3, 0.3};
   bool augment_flip = true;  // mirror y with probability 0.5
   std::uint64_t seed = 1;
 

@@ -2,10 +2,11 @@
 // Read from YAML (config/relation/intra_rm.yaml); an unknown key or a bad value fails loudly, naming it.
 #pragma once
 
-#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <string>
+
+#include "ret3d/core/per_class.h"
 
 namespace ret3d {
 namespace relation {
@@ -26,9 +27,6 @@ struct IntraRMArch {
   void validate() const;  // throws std::invalid_argument naming the field
 };
 
-// Per class (Car, Pedestrian, Cyclist, the order of kDetectedClasses).
-using PerClass = std::array<double, 3>;
-
 struct IntraRMTrainConfig {
   double lr = 3e-4;             // AdamW, as the paper
   double weight_decay = 0.01;
@@ -40,9 +38,9 @@ struct IntraRMTrainConfig {
   double focal_gamma = 2.0;
   // A detection is a positive of its class when its class-aware BEV IoU with a ground-truth box reaches this
   // (the KITTI 3D thresholds, so the refined score ranks boxes the benchmark counts as hits)...
-  PerClass cls_pos_iou{{0.7, 0.5, 0.5}};
+  PerClass<double> cls_pos_iou{0.7, 0.5, 0.5};
   // ...and its box is regressed towards that ground truth when the IoU reaches this.
-  PerClass reg_min_iou{{0.5, 0.3, 0.3}};
+  PerClass<double> reg_min_iou{0.5, 0.3, 0.3};
   bool augment_flip = true;        // mirror y (and yaw) with probability 0.5
   double augment_rotation = 0.39;  // rotate a frame about the sensor's z axis by U(-a, a) radians
   std::uint64_t seed = 1;

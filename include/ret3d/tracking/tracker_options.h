@@ -3,28 +3,12 @@
 // them in step.
 #pragma once
 
-#include <stdexcept>
 #include <string>
 
+#include "ret3d/core/per_class.h"
 #include "ret3d/core/types.h"
 
 namespace ret3d {
-
-// One value per tracked class (Car, Pedestrian, Cyclist).
-template <typename T>
-struct PerClass {
-  T car{}, pedestrian{}, cyclist{};
-  // Throws std::invalid_argument for ObjectClass::Unknown (not tracked).
-  const T& at(ObjectClass c) const {
-    switch (c) {
-      case ObjectClass::Car: return car;
-      case ObjectClass::Pedestrian: return pedestrian;
-      case ObjectClass::Cyclist: return cyclist;
-      default: throw std::invalid_argument("PerClass: the Unknown class has no per-class value");
-    }
-  }
-  T& at(ObjectClass c) { return const_cast<T&>(static_cast<const PerClass&>(*this).at(c)); }
-};
 
 enum class AssignmentMethod { Greedy, Hungarian };
 
