@@ -4,7 +4,7 @@
 #include <filesystem>
 #include <stdexcept>
 
-#include <yaml-cpp/yaml.h>
+#include "ret3d/core/yaml_reader.h"
 
 namespace ret3d {
 namespace tools {
@@ -24,15 +24,9 @@ std::string defaultTrackerConfig(const std::vector<std::string>& stages, const s
 double pipelineDetectorThreshold(const std::string& package_dir, double fallback) {
   const std::string path = (std::filesystem::path(package_dir) / kPipelineParams).string();
   if (package_dir.empty() || !std::filesystem::exists(path)) return fallback;
-  try {
-    const YAML::Node t = YAML::LoadFile(path)["ret3d_detector"]["score_threshold"];
-    if (!t) return fallback;
-    const double v = t.as<double>();
-    if (!(v >= 0 && v <= 1)) throw std::runtime_error("must lie in [0, 1]");
-    return v;
-  } catch (const std::exception& e) {
-    throw std::runtime_error(path + ": ret3d_detector/score_threshold: " + e.what());
-  }
+  double v = fallback;
+  YamlReader::load(path).child("ret3d_detector").get("score_threshold", &v, 0.0, 1.0);
+  return v;
 }
 
 }  // namespace tools
