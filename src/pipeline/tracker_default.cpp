@@ -1,11 +1,11 @@
-#include "tools/tracker_default.h"
+#include "ret3d/pipeline/tracker_default.h"
 
 #include <algorithm>
 #include <filesystem>
 #include <stdexcept>
 
 namespace ret3d {
-namespace tools {
+namespace pipeline {
 
 std::string defaultTrackerConfig(const std::vector<std::string>& stages, const std::string& package_dir) {
   if (std::find(stages.begin(), stages.end(), "base") == stages.end()) return "";
@@ -19,5 +19,5 @@ std::string defaultTrackerConfig(const std::vector<std::string>& stages, const s
   return path;
 }
 
-}  // namespace tools
+}  // namespace pipeline
 }  // namespace ret3d

@@ -6,7 +6,7 @@
 #include <vector>
 
 namespace ret3d {
-namespace tools {
+namespace pipeline {
 
 // The tracker YAML of the LWD-3D pipeline, relative to the package (config/ret3d.yaml names it for the nodelets).
 inline constexpr const char* kPipelineTrackerConfig = "config/tracker_lwd3d_pipeline.yaml";
@@ -17,5 +17,5 @@ inline constexpr const char* kPipelineTrackerConfig = "config/tracker_lwd3d_pipe
 // (the package is not on ROS_PACKAGE_PATH) or the file is missing.
 std::string defaultTrackerConfig(const std::vector<std::string>& stages, const std::string& package_dir);
 
-}  // namespace tools
+}  // namespace pipeline
 }  // namespace ret3d
