@@ -1,6 +1,7 @@
 // Parameter loading and validation for the nodelets (include/ret3d/ros/params.h).
 #include "ret3d/ros/params.h"
 
+#include <ros/names.h>
 #include <ros/package.h>
 
 #include <sstream>
@@ -250,8 +251,22 @@ InterRMNodeletParams loadInterRMNodeletParams(const ros::NodeHandle& private_nh)
   params.passthrough = p.boolean("passthrough", false);
   params.inter.model_path = p.nonEmpty("model_path", defaultModelPath("inter_rm.pt"));
   params.inter.threads = p.integer("threads", 2, 1, 64);
-  params.max_age = p.integer("max_age", params.max_age, 0, 1000);
   params.pose = loadPoseParams(p);
+  if (params.passthrough) return params;  // no histories kept
+  // The tracker's own configuration, read as the tracker nodelet reads it (one home for max_age).
+  const std::string tracker_node = p.nonEmpty("tracker_node", "ret3d_tracker");
+  const ros::NodeHandle tracker_nh(ros::NodeHandle(ros::names::parentNamespace(private_nh.getNamespace())),
+                                   tracker_node);
+  const int tracker_max_age = loadTrackerNodeletParams(tracker_nh).tracker.max_age;
+  params.max_age = p.integer("max_age", tracker_max_age, 0, 1000);
+  if (params.max_age != tracker_max_age) {
+    params.max_age_warning = "parameter " + p.fullName("max_age") + " = " + std::to_string(params.max_age) +
+                             " differs from the tracker's max_age " + std::to_string(tracker_max_age) + " (" +
+                             tracker_nh.getNamespace() + "): track histories " +
+                             (params.max_age < tracker_max_age ? "of coasting tracks are dropped before they end"
+                                                               : "are kept longer than their tracks") +
+                             "; remove ~max_age to follow the tracker";
+  }
   return params;
 }
 

@@ -26,7 +26,7 @@
 #include "ret3d/sim/sequence_writer.h"
 #include "ret3d/tracking/track_smoothing.h"
 #include "tools/command.h"
-#include "tools/offline_pipeline.h"
+#include "tools/pipeline_options.h"
 
 namespace ret3d {
 namespace tools {
@@ -38,7 +38,7 @@ using Clock = std::chrono::steady_clock;
 constexpr double kFramePeriod = 0.1;  // s: KITTI's 10 Hz, as `ret3d detect` stamps frames
 
 struct AutolabelArgs {
-  PipelineConfig pipeline;
+  pipeline::PipelineConfig pipeline;
   TrackSmoothingOptions smoothing;
   std::string data, out, stages = "base,intra,track,inter", sequences;
   bool copy_scans = false, no_scan_matching = false;
@@ -112,7 +112,7 @@ struct Totals {
 };
 
 void labelSequence(const AutolabelArgs& a, const kitti::TrackingDataset& ds, const std::string& seq,
-                   OfflinePipeline* p, Totals* totals) {
+                   pipeline::OfflinePipeline* p, Totals* totals) {
   const fs::path out = fs::path(a.out) / "training";
   const std::vector<int> frames = ds.frames(seq);
   if (frames.empty()) {
@@ -197,7 +197,7 @@ void labelSequence(const AutolabelArgs& a, const kitti::TrackingDataset& ds, con
 }
 
 int runAutolabel(AutolabelArgs a) {
-  a.pipeline.stages = parseStages(a.stages);
+  a.pipeline.stages = pipeline::parseStages(a.stages);
   const auto& st = a.pipeline.stages;
   if (st.empty() || st.front() != "base")
     throw std::runtime_error("--stages must start with base: autolabel detects on the scans of --data");
@@ -215,7 +215,7 @@ int runAutolabel(AutolabelArgs a) {
                              "FFFFFF.bin, or a folder of FFFFFF.bin scans expected)");
   for (const char* sub : {"velodyne", "label_02", "calib", "pose"})
     fs::create_directories(fs::path(a.out) / "training" / sub);
-  OfflinePipeline p(a.pipeline);
+  pipeline::OfflinePipeline p(withPackageDir(a.pipeline));
   std::cout << "autolabel: " << p.describe() << std::endl;
   Totals t;
   for (const std::string& seq : seqs) labelSequence(a, ds, seq, &p, &t);
@@ -238,7 +238,7 @@ CommandRegistrar reg("autolabel", "pseudo-labels for unlabelled sequences: pipel
                      "written as a KITTI tracking dataset",
                      [](CLI::App& app) -> CommandRun {
   auto a = std::make_shared<AutolabelArgs>();
-  PipelineConfig& p = a->pipeline;
+  pipeline::PipelineConfig& p = a->pipeline;
   p.models = "models/lwd3d";
   TrackSmoothingOptions& s = a->smoothing;
   app.add_option("--data", a->data, "unlabelled scans: a KITTI tracking root (training/velodyne/SSSS/FFFFFF.bin, "

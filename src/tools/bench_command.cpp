@@ -35,7 +35,7 @@
 #include "ret3d/ros/params.h"
 #include "tools/command.h"
 #include "tools/nodelet_bench.h"
-#include "tools/offline_pipeline.h"
+#include "tools/pipeline_options.h"
 
 namespace ret3d {
 namespace tools {
@@ -44,7 +44,7 @@ namespace {
 namespace fs = std::filesystem;
 
 struct BenchArgs {
-  PipelineConfig pipeline;
+  pipeline::PipelineConfig pipeline;
   std::string data, bag, topic, stages = "base,intra,track,inter", json, sequence, objects = "50,300";
   int warmup = 5, min_runs = 100, max_frames = 200, history_frames = 40;
   bool in_process = false;  // --bag: time the stages in this process instead of through the nodelets
@@ -57,12 +57,13 @@ struct BenchArgs {
 // The baseline's pipeline: the detector of `dir` with its own configuration (stored in the model file, or `config`)
 // and its own grid; its IntraRM / InterRM where `dir` has them, else the same as the new pipeline's. Stage list,
 // threads, score threshold and tracker config are the run's.
-PipelineConfig baselineConfig(const PipelineConfig& p, const std::string& dir, const std::string& config) {
+pipeline::PipelineConfig baselineConfig(const pipeline::PipelineConfig& p, const std::string& dir,
+                                        const std::string& config) {
   if (!fs::is_directory(dir)) throw std::runtime_error("--baseline " + dir + ": no such folder");
   const fs::path detector = fs::path(dir) / "detector.pt";
   if (!fs::is_regular_file(detector))
     throw std::runtime_error("--baseline " + dir + ": no detector.pt there (a folder of models, e.g. models/lwd3d)");
-  PipelineConfig b = p;
+  pipeline::PipelineConfig b = p;
   b.detector_model = detector.string();
   b.detector_config = config;
   b.grid_extent.clear();
@@ -198,7 +199,7 @@ void writeJson(const std::string& path, const std::string& text) {
 // length, in frames).
 int benchSynthetic(const BenchArgs& a) {
   if (!a.baseline.empty()) throw std::runtime_error("--baseline compares detectors: --stages must start with base");
-  OfflinePipeline p(a.pipeline);
+  pipeline::OfflinePipeline p(withPackageDir(a.pipeline));
   const std::optional<BusyLoad> busy = a.nodelets.load > 0 ? std::make_optional<BusyLoad>(a.nodelets.load) : std::nullopt;
   std::cout << "bench: " << p.describe() << "; " << a.pipeline.threads << " threads, " << a.warmup
             << " warm-up and " << a.min_runs << " timed frames per case\n";
@@ -259,7 +260,7 @@ std::string nodeletModel(const std::string& explicit_path, const std::string& mo
   return path;
 }
 
-NodeletBenchOptions nodeletOptions(const BenchArgs& a, const PipelineConfig& p) {
+NodeletBenchOptions nodeletOptions(const BenchArgs& a, const pipeline::PipelineConfig& p) {
   NodeletBenchOptions o = a.nodelets;
   auto has = [&](const char* s) { return std::find(p.stages.begin(), p.stages.end(), s) != p.stages.end(); };
   o.bag = a.bag;
@@ -284,7 +285,7 @@ NodeletBenchOptions nodeletOptions(const BenchArgs& a, const PipelineConfig& p) 
 // node), then the new models in this one, one after the other on the same bag; the child's figures come back
 // through a pipe.
 int benchNodeletsAgainstBaseline(const BenchArgs& a) {
-  const PipelineConfig base_config = baselineConfig(a.pipeline, a.baseline, a.baseline_config);
+  const pipeline::PipelineConfig base_config = baselineConfig(a.pipeline, a.baseline, a.baseline_config);
   NodeletBenchOptions base = nodeletOptions(a, base_config);
   NodeletBenchOptions now = nodeletOptions(a, a.pipeline);
   if (!now.json.empty()) base.json = (fs::path(now.json).parent_path() / fs::path(now.json).stem()).string() +
@@ -349,7 +350,7 @@ int benchNodelets(const BenchArgs& a) {
 }
 
 // The base detector per frame (BEV + network + decoding + NMS + point refinement), the figure of the latency budget.
-std::vector<double> baseTimes(const OfflinePipeline& p) {
+std::vector<double> baseTimes(const pipeline::OfflinePipeline& p) {
   const auto& t = p.times().all();
   std::vector<double> base;
   for (std::size_t i = 0; i < t.at("bev").size(); ++i)
@@ -358,7 +359,7 @@ std::vector<double> baseTimes(const OfflinePipeline& p) {
 }
 
 int runBench(BenchArgs a) {
-  a.pipeline.stages = parseStages(a.stages);
+  a.pipeline.stages = pipeline::parseStages(a.stages);
   if (a.nodelets.load < 0) throw std::runtime_error("--load must be >= 0, not " + std::to_string(a.nodelets.load));
   const bool nodelets = !a.bag.empty() && a.data.empty() && !a.in_process;
   if (a.nodelets.loop_frames != 0 && !nodelets)
@@ -373,9 +374,9 @@ int runBench(BenchArgs a) {
                              "neither: the later stages are timed on synthetic frames of --objects objects");
   const std::vector<BenchFrame> frames = a.bag.empty() ? framesFromData(a) : framesFromBag(a);
   if (frames.empty()) throw std::runtime_error("no frames to time");
-  OfflinePipeline p(a.pipeline);
-  std::optional<OfflinePipeline> baseline;
-  if (!a.baseline.empty()) baseline.emplace(baselineConfig(a.pipeline, a.baseline, a.baseline_config));
+  pipeline::OfflinePipeline p(withPackageDir(a.pipeline));
+  std::optional<pipeline::OfflinePipeline> baseline;
+  if (!a.baseline.empty()) baseline.emplace(withPackageDir(baselineConfig(a.pipeline, a.baseline, a.baseline_config)));
   std::size_t points = 0;
   for (const BenchFrame& f : frames) points += f.cloud.size();
   std::cout << "bench: " << p.describe() << "\n";
@@ -445,7 +446,7 @@ int runBench(BenchArgs a) {
 CommandRegistrar reg("bench", "time the pipeline: through the nodelets on a bag, or each stage in-process (median and p95)",
                      [](CLI::App& app) -> CommandRun {
   auto a = std::make_shared<BenchArgs>();
-  PipelineConfig& p = a->pipeline;
+  pipeline::PipelineConfig& p = a->pipeline;
   app.add_option("--data", a->data, "scans: a folder of .bin files, a KITTI object or tracking folder");
   app.add_option("--sequence", a->sequence, "tracking layout: the sequence to time (default: the first)");
   app.add_option("--bag", a->bag, "a bag played through the real nodelets in one manager (with --in-process: its "

@@ -26,7 +26,7 @@
 #include "ret3d/io/sweeps.h"
 #include "ret3d/io/track_velocity.h"
 #include "tools/command.h"
-#include "tools/offline_pipeline.h"
+#include "tools/pipeline_options.h"
 
 namespace ret3d {
 namespace tools {
@@ -35,7 +35,7 @@ namespace {
 namespace fs = std::filesystem;
 
 struct DetectArgs {
-  PipelineConfig pipeline;
+  pipeline::PipelineConfig pipeline;
   std::string data, detections, out, stages = "base", sequences, velocity_report;
 };
 
@@ -123,7 +123,7 @@ std::size_t detectObjectFrames(const DetectArgs& a, DetectFrame detect) {
 }
 
 // The base detector on a KITTI-layout folder's scans.
-std::size_t detectFromScans(const DetectArgs& a, OfflinePipeline* p) {
+std::size_t detectFromScans(const DetectArgs& a, pipeline::OfflinePipeline* p) {
   std::size_t boxes = 0;
   if (isObjectLayout(a.data)) {
     if (p->tracks()) throw std::runtime_error("--stages track/inter need sequences: " + a.data + " has the object layout");
@@ -166,7 +166,7 @@ std::size_t detectFromScans(const DetectArgs& a, OfflinePipeline* p) {
 }
 
 // The later stages on another detector's result files.
-std::size_t detectFromResults(const DetectArgs& a, OfflinePipeline* p) {
+std::size_t detectFromResults(const DetectArgs& a, pipeline::OfflinePipeline* p) {
   const io::DetectionLayout layout = io::detectDetectionLayout(a.detections);
   const Eigen::Isometry3d I = Eigen::Isometry3d::Identity();
   std::size_t boxes = 0;
@@ -221,14 +221,14 @@ double median(std::vector<double> v) {
 }
 
 int runDetect(DetectArgs a) {
-  a.pipeline.stages = parseStages(a.stages);
+  a.pipeline.stages = pipeline::parseStages(a.stages);
   const bool base = !a.pipeline.stages.empty() && a.pipeline.stages.front() == "base";
   if (a.data.empty() || a.out.empty()) throw std::runtime_error("--data and --out are required");
   if (base && !a.detections.empty())
     throw std::runtime_error("--detections and the base stage exclude each other: the base stage makes the boxes");
   if (!base && a.detections.empty())
     throw std::runtime_error("without the base stage the boxes come from --detections DIR (another detector's results)");
-  OfflinePipeline p(a.pipeline);
+  pipeline::OfflinePipeline p(withPackageDir(a.pipeline));
   std::cout << "detect: " << p.describe() << std::endl;
   fs::create_directories(a.out);
   const std::size_t boxes = base ? detectFromScans(a, &p) : detectFromResults(a, &p);
@@ -244,7 +244,7 @@ int runDetect(DetectArgs a) {
 CommandRegistrar reg("detect", "run the pipeline offline (base detector, IntraRM, tracker, InterRM) to KITTI results",
                      [](CLI::App& app) -> CommandRun {
   auto a = std::make_shared<DetectArgs>();
-  PipelineConfig& p = a->pipeline;
+  pipeline::PipelineConfig& p = a->pipeline;
   app.add_option("--data", a->data, "KITTI tracking or object root (scans for the base stage, calibration, poses), or a "
                  "plain folder of consecutive FFFFFF.bin scans (one sequence, 0000)")
       ->required();

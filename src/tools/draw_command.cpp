@@ -23,7 +23,7 @@
 #include "ret3d/ros/markers.h"
 #include "tools/bev_image.h"
 #include "tools/command.h"
-#include "tools/offline_pipeline.h"
+#include "tools/pipeline_options.h"
 
 namespace ret3d {
 namespace tools {
@@ -32,7 +32,7 @@ namespace {
 namespace fs = std::filesystem;
 
 struct DrawArgs {
-  PipelineConfig pipeline;
+  pipeline::PipelineConfig pipeline;
   std::string scan, labels, calib, pred, out, title;
   std::string view = "around", extent, shade = "height";
   int size = 1000;
@@ -130,7 +130,7 @@ int runDraw(DrawArgs a) {
   BevView view;
   if (detector) {
     a.pipeline.stages = {"base"};
-    OfflinePipeline p(a.pipeline);
+    pipeline::OfflinePipeline p(withPackageDir(a.pipeline));
     const Detections d = p.run(&cloud, nullptr, Eigen::Isometry3d::Identity(), {}, 0.0, Eigen::Isometry3d::Identity());
     dets = d.boxes;
     const BevGeometry g = p.detector()->options().inferenceGeometry();
@@ -253,7 +253,7 @@ int runDraw(DrawArgs a) {
 CommandRegistrar reg("draw", "a bird's-eye-view PNG of a scan with ground truth and detections",
                      [](CLI::App& app) -> CommandRun {
   auto a = std::make_shared<DrawArgs>();
-  PipelineConfig& p = a->pipeline;
+  pipeline::PipelineConfig& p = a->pipeline;
   app.add_option("--scan", a->scan, "velodyne scan (KITTI .bin, N x 4 float32)")->required()->check(CLI::ExistingFile);
   app.add_option("--out", a->out, "PNG file to write")->required();
   app.add_option("--labels", a->labels, "KITTI object label file (ground truth, drawn white; needs --calib)")

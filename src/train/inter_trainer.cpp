@@ -15,8 +15,10 @@
 #include "ret3d/core/progress.h"
 #include "ret3d/io/detections.h"
 #include "ret3d/io/kitti.h"
+#include "ret3d/pipeline/track_histories.h"
 #include "ret3d/relation/intra_rm.h"
 #include "ret3d/relation/intra_rm_targets.h"
+#include "ret3d/tracking/greedy_tracker.h"
 
 #include "epoch_loop.h"
 
@@ -24,47 +26,6 @@ namespace ret3d {
 namespace train {
 
 using relation::InterRMSample;
-using relation::InterRMSequence;
-
-InterRMSequence toInterRMSequence(const std::vector<TimedBox>& history, const Box* current) {
-  InterRMSequence s;
-  s.boxes.reserve(history.size() + (history.empty() ? 1 : 0));
-  s.dt.reserve(s.boxes.capacity());
-  for (auto it = history.rbegin(); it != history.rend(); ++it) {
-    s.boxes.push_back(it->box);
-    s.dt.push_back(it->dt);
-  }
-  if (current) {
-    if (s.boxes.empty()) {
-      s.boxes.push_back(*current);
-      s.dt.push_back(0.0);
-    } else {
-      s.boxes[0] = *current;
-    }
-  }
-  return s;
-}
-
-TrackingRefiner::TrackingRefiner(const TrackerOptions& tracker, const relation::InterRM* inter)
-    : tracker_(tracker), inter_(inter) {}
-
-std::vector<Box> TrackingRefiner::update(const std::vector<Box>& detections, double stamp,
-                                         const Eigen::Isometry3d& sensor_to_fixed) {
-  const auto t0 = std::chrono::steady_clock::now();
-  std::vector<Box> tracked = tracker_.update(detections, stamp, sensor_to_fixed);
-  const auto t1 = std::chrono::steady_clock::now();
-  if (inter_ && !tracked.empty()) {
-    std::vector<InterRMSequence> seqs;
-    seqs.reserve(tracked.size());
-    for (const Box& b : tracked) seqs.push_back(toInterRMSequence(tracker_.history(b.track_id), &b));
-    tracked = inter_->refine(seqs);
-  }
-  const auto t2 = std::chrono::steady_clock::now();
-  tracker_s_ += std::chrono::duration<double>(t1 - t0).count();
-  inter_s_ += std::chrono::duration<double>(t2 - t1).count();
-  ++frames_;
-  return tracked;
-}
 
 std::vector<InterRMSample> loadInterSamples(const InterDataOptions& data, const relation::InterRMTrainConfig& config) {
   namespace fs = std::filesystem;
@@ -116,21 +77,25 @@ std::vector<InterRMSample> loadInterSamples(const InterDataOptions& data, const 
       throw std::runtime_error("sequence " + seq + ": detections up to frame " + std::to_string(dets.rbegin()->first) +
                                " but only " + std::to_string(poses.size()) + " poses");
     GreedyTracker tracker(data.tracker);
+    pipeline::TrackHistories histories(static_cast<std::size_t>(data.tracker.history_length), data.tracker.max_age);
     for (int f = 0; f <= last; ++f) {
       Detections d;
       if (auto it = dets.find(f); it != dets.end()) d = it->second;
       if (intra && !d.empty()) d = intra->refine(d);
-      const std::vector<Box> tracked =
-          tracker.update(d.boxes, f * data.frame_period, poses[static_cast<std::size_t>(f)]);
+      const double stamp = f * data.frame_period;
+      const Eigen::Isometry3d& pose = poses[static_cast<std::size_t>(f)];
+      const std::vector<Box> tracked = tracker.update(d.boxes, stamp, pose);
+      pipeline::TrackHistories::Sequences sequences = histories.update(tracked, stamp, pose);
       if (tracked.empty()) continue;
       const auto g = gt.find(f);
       if (g == gt.end()) continue;
       const auto targets = relation::assignIntraRMTargets(tracked, g->second, assign);
-      for (std::size_t i = 0; i < tracked.size(); ++i) {
+      for (std::size_t k = 0; k < sequences.rows.size(); ++k) {
+        const std::size_t i = sequences.rows[k];
         const relation::IntraRMTarget& t = targets[i];
         if (!t.regress) continue;
         InterRMSample s;
-        s.sequence = toInterRMSequence(tracker.history(tracked[i].track_id), &tracked[i]);
+        s.sequence = std::move(sequences.sequences[k]);
         Box target = tracked[i];
         target.x += t.dx, target.y += t.dy, target.z += t.dz;
         target.length *= std::exp(t.dl), target.width *= std::exp(t.dw), target.height *= std::exp(t.dh);

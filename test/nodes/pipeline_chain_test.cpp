@@ -248,7 +248,10 @@ TEST_F(PipelineChain, MissingTransformAndBackwardsStampsKeepItRunning) {
 // A nodelet that cannot run as configured refuses to start and says why.
 class PipelineStart : public ::testing::Test {
  protected:
-  void TearDown() override { ros::param::del("/bad"); }
+  void TearDown() override {
+    ros::param::del("/bad");
+    ros::param::del("/bad_tracker");
+  }
   // Loads `type` as /bad and expects a refusal whose log line holds every part of `said`.
   void expectRefusal(const std::string& type, const std::vector<std::string>& said) {
     nodelet::Loader loader(false);
@@ -293,6 +296,34 @@ TEST_F(PipelineStart, CorruptModelFileIsRefused) {
   std::ofstream(tmp_ / "corrupt.pt", std::ios::binary).write(bytes.data(), bytes.size() / 2);
   ros::param::set("/bad/model_path", tmp_ / "corrupt.pt");
   expectRefusal("ret3d/InterRMNodelet", {"/bad/model_path", "corrupt.pt"});
+}
+
+// InterRM's histories age out with the tracker's max_age, read from the tracker nodelet's own parameters
+// (~tracker_node names it): a tracker option the tracker would refuse stops InterRM too, naming it.
+TEST_F(PipelineStart, InterRMReadsTheTrackersOptions) {
+  XmlRpc::XmlRpcValue tracker;
+  tracker["max_age"] = -3;
+  ros::param::set("/bad_tracker/tracker", tracker);
+  ros::param::set("/bad/tracker_node", std::string("bad_tracker"));
+  expectRefusal("ret3d/InterRMNodelet", {"/bad_tracker/tracker", "max_age", "-3"});
+}
+
+// A ~max_age left over from older parameter files still applies, but a value other than the tracker's is said.
+TEST_F(PipelineStart, InterRMWarnsWhenItsMaxAgeDiffersFromTheTrackers) {
+  relation::InterRMArch arch;
+  arch.c_enc = 32;
+  arch.heads = 4;
+  relation::InterRM(arch, 1).save(tmp_ / "inter.pt");
+  XmlRpc::XmlRpcValue tracker;
+  tracker["max_age"] = 4;
+  ros::param::set("/bad_tracker/tracker", tracker);
+  ros::param::set("/bad/tracker_node", std::string("bad_tracker"));
+  ros::param::set("/bad/model_path", tmp_ / "inter.pt");
+  ros::param::set("/bad/max_age", 9);
+  nodelet::Loader loader(false);
+  ASSERT_TRUE(test::loadNodelet(loader, "/bad", "ret3d/InterRMNodelet")) << log_.all();
+  EXPECT_FALSE(log_.find({"/bad/max_age = 9", "differs from the tracker's max_age 4", "/bad_tracker"}).empty())
+      << log_.all();
 }
 
 TEST_F(PipelineStart, WrongParameterTypeIsNamed) {

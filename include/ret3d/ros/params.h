@@ -91,9 +91,12 @@ struct InterRMNodeletParams {
   relation::InterRMOptions inter;    // ~model_path, ~threads
   bool passthrough = false;          // ~passthrough: no model, tracked boxes published unrefined (stage off)
   PoseParams pose;
-  // Histories of track ids not seen for more than this many frames are dropped (the tracker's max_age by default:
-  // a track that coasts longer than that never comes back with the same id).
+  // Histories of track ids not seen for more than this many frames are dropped: the tracker's max_age, read from the
+  // tracker nodelet's own parameters (~tracker_node, default "ret3d_tracker", a sibling of this nodelet), since a
+  // track that coasts longer than that never comes back with the same id. ~max_age, when set, overrides it (kept for
+  // older parameter files; a warning when it differs from the tracker's).
   int max_age = TrackerOptions().max_age;
+  std::string max_age_warning;       // non-empty: ~max_age disagrees with the tracker's (the nodelet logs it)
 };
 struct MarkerNodeletParams {
   MarkerOptions markers;
@@ -104,6 +107,8 @@ StageParams loadStageParams(const ros::NodeHandle& private_nh);
 DetectorNodeletParams loadDetectorNodeletParams(const ros::NodeHandle& private_nh);
 IntraRMNodeletParams loadIntraRMNodeletParams(const ros::NodeHandle& private_nh);
 TrackerNodeletParams loadTrackerNodeletParams(const ros::NodeHandle& private_nh);
+// Reads the tracker's max_age from the tracker nodelet's parameters with loadTrackerNodeletParams (its namespace:
+// ~tracker_node resolved in private_nh's parent namespace).
 InterRMNodeletParams loadInterRMNodeletParams(const ros::NodeHandle& private_nh);
 MarkerNodeletParams loadMarkerNodeletParams(const ros::NodeHandle& private_nh);
 

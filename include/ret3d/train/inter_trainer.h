@@ -1,48 +1,19 @@
-// InterRM (Ret3D §3.3) on tracked sequences: the glue between the tracker's histories and InterRM (used by training,
-// `ret3d detect --stages ...,inter` and the benchmarks), building training sequences by running the tracker over
-// another detector's boxes with the real ego poses (optionally IntraRM first), and the epoch loop with checkpoints.
+// InterRM (Ret3D §3.3) training: sequences built by running the tracker over another detector's boxes with the real
+// ego poses (optionally IntraRM first), through the same TrackHistories the pipeline refines from
+// (pipeline/track_histories.h), and the epoch loop with checkpoints.
 #pragma once
 
 #include <memory>
 #include <string>
 #include <vector>
 
-#include <Eigen/Geometry>
-
 #include "ret3d/io/detection_cache.h"
 #include "ret3d/relation/inter_rm.h"
 #include "ret3d/relation/inter_rm_learner.h"
-#include "ret3d/tracking/greedy_tracker.h"
+#include "ret3d/tracking/tracker_options.h"
 
 namespace ret3d {
 namespace train {
-
-// A tracker history (oldest first, the last entry the current box) as an InterRM sequence (newest first). When
-// `current` is given, it replaces the newest entry (the tracked box as output, exactly).
-relation::InterRMSequence toInterRMSequence(const std::vector<TimedBox>& history, const Box* current = nullptr);
-
-// The tracker followed by InterRM, one frame at a time: what runs online after the detector (and IntraRM).
-class TrackingRefiner {
- public:
-  // `inter` may be null: tracking only. The refiner does not own it.
-  TrackingRefiner(const TrackerOptions& tracker, const relation::InterRM* inter);
-  // Tracks the frame's detections (sensor frame, at `stamp`, sensor pose in the fixed frame) and refines every tracked
-  // box from its history. Returns the tracked boxes with track ids (sensor frame).
-  std::vector<Box> update(const std::vector<Box>& detections, double stamp, const Eigen::Isometry3d& sensor_to_fixed);
-  // A new sequence: forget the tracks (ids keep counting).
-  void reset() { tracker_.reset(); }
-  const GreedyTracker& tracker() const { return tracker_; }
-
-  double trackerSeconds() const { return tracker_s_; }
-  double interSeconds() const { return inter_s_; }
-  std::size_t frames() const { return frames_; }
-
- private:
-  GreedyTracker tracker_;
-  const relation::InterRM* inter_;
-  double tracker_s_ = 0, inter_s_ = 0;
-  std::size_t frames_ = 0;
-};
 
 struct InterDataOptions {
   std::string data_dir;        // KITTI tracking root (label_02, calib, pose or oxts)

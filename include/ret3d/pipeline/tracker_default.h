@@ -6,7 +6,7 @@
 #include <vector>
 
 namespace ret3d {
-namespace tools {
+namespace pipeline {
 
 // The tracker YAML of the LWD-3D pipeline, relative to the package (config/ret3d.yaml names it for the nodelets).
 inline constexpr const char* kPipelineTrackerConfig = "config/tracker_lwd3d_pipeline.yaml";
@@ -25,5 +25,5 @@ inline constexpr const char* kPipelineParams = "config/ret3d.yaml";
 // through weak detections and starts them only from its birth scores). `fallback` when the file or key is absent.
 double pipelineDetectorThreshold(const std::string& package_dir, double fallback);
 
-}  // namespace tools
+}  // namespace pipeline
 }  // namespace ret3d

@@ -1,6 +1,6 @@
 // The tracker config `ret3d detect|bench|autolabel` run without --tracker-config: the nodelets' one with the base
 // stage, the built-in values for external detections.
-#include "tools/tracker_default.h"
+#include "ret3d/pipeline/tracker_default.h"
 
 #include <filesystem>
 #include <fstream>
@@ -14,7 +14,7 @@
 #include "test_util.h"
 
 namespace ret3d {
-namespace tools {
+namespace pipeline {
 namespace {
 
 const std::string kPackage = RET3D_SOURCE_DIR;
@@ -76,5 +76,5 @@ TEST(TrackerDefault, TheDetectorFeedsTheTrackerFromTheNodeletsThreshold) {
 }
 
 }  // namespace
-}  // namespace tools
+}  // namespace pipeline
 }  // namespace ret3d

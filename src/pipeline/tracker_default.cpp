@@ -1,4 +1,4 @@
-#include "tools/tracker_default.h"
+#include "ret3d/pipeline/tracker_default.h"
 
 #include <algorithm>
 #include <filesystem>
@@ -7,7 +7,7 @@
 #include "ret3d/core/yaml_reader.h"
 
 namespace ret3d {
-namespace tools {
+namespace pipeline {
 
 std::string defaultTrackerConfig(const std::vector<std::string>& stages, const std::string& package_dir) {
   if (std::find(stages.begin(), stages.end(), "base") == stages.end()) return "";
@@ -29,5 +29,5 @@ double pipelineDetectorThreshold(const std::string& package_dir, double fallback
   return v;
 }
 
-}  // namespace tools
+}  // namespace pipeline
 }  // namespace ret3d

@@ -1,5 +1,7 @@
 // The ret3d pipeline run offline, frame by frame, as the nodelets run it online: base detector (on point clouds),
-// IntraRM, tracker, InterRM. Shared by `ret3d detect` (writes KITTI results) and `ret3d bench` (times each stage).
+// IntraRM, tracker, InterRM. Shared by `ret3d detect` (writes KITTI results), `ret3d bench` (times each stage),
+// `ret3d autolabel` and `ret3d draw`. No ROS here: what only the command line knows (the package folder) comes in the
+// config.
 #pragma once
 
 #include <map>
@@ -12,30 +14,29 @@
 #include "ret3d/core/detections.h"
 #include "ret3d/core/types.h"
 #include "ret3d/detector/detector.h"
+#include "ret3d/pipeline/track_refiner.h"
 #include "ret3d/relation/inter_rm.h"
 #include "ret3d/relation/intra_rm.h"
-#include "ret3d/train/inter_trainer.h"
-
-namespace CLI {
-class App;
-}
 
 namespace ret3d {
-namespace tools {
+namespace pipeline {
 
 struct PipelineConfig {
   std::vector<std::string> stages;  // in order, from: base, intra, track, inter ("inter" implies the tracker)
   std::string models;               // folder with detector.pt, intra_rm.pt, inter_rm.pt (the defaults below)
   std::string detector_model, intra_model, inter_model;  // explicit files win over --models
   std::string detector_config;      // YAML for the detector's inference options (default: those it was trained with)
-  std::string tracker_config;       // tracker YAML; empty: defaultTrackerConfig(stages) (tools/tracker_default.h)
+  std::string tracker_config;       // tracker YAML; empty: defaultTrackerConfig(stages, package_dir)
+  std::string package_dir;          // the ret3d package folder; only read when usesPackageDir(config)
   double score_threshold = -1;      // >= 0: overrides the detector's inference.score_threshold
   std::vector<double> grid_extent;  // non-empty: overrides inference.grid_extent [x_min, x_max, y_min, y_max]
   int threads = 2;
 };
 
-// The --grid-extent option of the commands that run the detector (x_min,x_max,y_min,y_max in metres).
-void addGridExtentOption(CLI::App& app, std::vector<double>* extent);
+// True when the pipeline needs config.package_dir: the base stage tracks, without --tracker-config (the nodelets'
+// tracker config) or without --score-threshold (the threshold the nodelets' detector feeds their tracker from;
+// pipeline/tracker_default.h).
+bool usesPackageDir(const PipelineConfig& config);
 
 // Parses "base,intra,track" (or "none"): throws naming an unknown stage or a misplaced one.
 std::vector<std::string> parseStages(const std::string& list);
@@ -60,7 +61,8 @@ class OfflinePipeline {
 
   bool hasBase() const { return static_cast<bool>(detector_); }
   bool tracks() const { return static_cast<bool>(tracking_); }
-  int historyLength() const { return history_length_; }  // boxes kept per track (0 without tracking)
+  // Boxes kept per track (0 without tracking): InterRM's history length, or the tracker's without InterRM.
+  int historyLength() const { return history_length_; }
   const Detector* detector() const { return detector_.get(); }
   // Length of the detector features IntraRM expects with each box (0: none, or no IntraRM stage).
   std::size_t intraFeatureDim() const;
@@ -83,9 +85,9 @@ class OfflinePipeline {
   std::unique_ptr<relation::IntraRM> intra_;
   std::unique_ptr<relation::InterRM> inter_;
   int history_length_ = 0;
-  std::unique_ptr<train::TrackingRefiner> tracking_;
+  std::unique_ptr<TrackRefiner> tracking_;
   StageTimes times_;
 };
 
-}  // namespace tools
+}  // namespace pipeline
 }  // namespace ret3d

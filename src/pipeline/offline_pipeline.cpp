@@ -1,4 +1,4 @@
-#include "tools/offline_pipeline.h"
+#include "ret3d/pipeline/offline_pipeline.h"
 
 #include <algorithm>
 #include <chrono>
@@ -6,15 +6,12 @@
 #include <sstream>
 #include <stdexcept>
 
-#include <CLI/CLI.hpp>
-
 #include "ret3d/detector/model_file.h"
-#include "ret3d/ros/params.h"
+#include "ret3d/pipeline/tracker_default.h"
 #include "ret3d/tracking/tracker_options.h"
-#include "tools/tracker_default.h"
 
 namespace ret3d {
-namespace tools {
+namespace pipeline {
 
 namespace {
 
@@ -33,6 +30,15 @@ std::string resolveModel(const std::string& explicit_path, const std::string& mo
     throw std::runtime_error("--stages " + stage + " needs " + what + ": --models DIR with " + name + ", or " + option +
                              " FILE");
   return p;
+}
+
+// A relation module (IntraRM, InterRM) from its file, run with `threads`.
+template <typename Module, typename Options>
+std::unique_ptr<Module> loadModule(const std::string& path, int threads) {
+  Options o;
+  o.model_path = path;
+  o.threads = threads;
+  return std::make_unique<Module>(o);
 }
 
 bool has(const std::vector<std::string>& v, const std::string& s) { return std::find(v.begin(), v.end(), s) != v.end(); }
@@ -58,12 +64,10 @@ std::vector<std::string> parseStages(const std::string& list) {
   return out;
 }
 
-void addGridExtentOption(CLI::App& app, std::vector<double>* extent) {
-  app.add_option("--grid-extent", *extent,
-                 "run the detector over this grid, x_min,x_max,y_min,y_max in m (e.g. --grid-extent=-80,80,-48,48; "
-                 "default: the model's); the cost grows with the area")
-      ->delimiter(',')
-      ->expected(4);
+bool usesPackageDir(const PipelineConfig& c) {
+  // The nodelets' tracker config and the threshold their detector feeds it from (pipelineDetectorThreshold).
+  return (c.tracker_config.empty() || c.score_threshold < 0) && has(c.stages, "base") &&
+         (has(c.stages, "track") || has(c.stages, "inter"));
 }
 
 OfflinePipeline::OfflinePipeline(const PipelineConfig& c) : stages_(c.stages) {
@@ -80,7 +84,7 @@ OfflinePipeline::OfflinePipeline(const PipelineConfig& c) : stages_(c.stages) {
       o.inference.score_threshold = c.score_threshold;
     } else if (has(stages_, "track") || has(stages_, "inter")) {  // as the nodelets feed their tracker
       o.inference.score_threshold =
-          static_cast<float>(pipelineDetectorThreshold(packagePath(), o.inference.score_threshold));
+          static_cast<float>(pipelineDetectorThreshold(c.package_dir, o.inference.score_threshold));
     }
     if (!c.grid_extent.empty()) {
       o.inference.grid_extent = c.grid_extent;
@@ -95,31 +99,25 @@ OfflinePipeline::OfflinePipeline(const PipelineConfig& c) : stages_(c.stages) {
          << " parameters, score >= " << o.inference.score_threshold << ", grid " << o.inferenceGeometry().describe() << ")";
   }
   if (has(stages_, "intra")) {
-    relation::IntraRMOptions o;
-    o.model_path = resolveModel(c.intra_model, c.models, "intra_rm.pt", "intra", "an IntraRM model", "--intra-model");
-    o.threads = c.threads;
-    intra_ = std::make_unique<relation::IntraRM>(o);
-    desc << "; IntraRM " << o.model_path;
+    const std::string path =
+        resolveModel(c.intra_model, c.models, "intra_rm.pt", "intra", "an IntraRM model", "--intra-model");
+    intra_ = loadModule<relation::IntraRM, relation::IntraRMOptions>(path, c.threads);
+    desc << "; IntraRM " << path;
   }
   if (has(stages_, "inter")) {
-    relation::InterRMOptions o;
-    o.model_path = resolveModel(c.inter_model, c.models, "inter_rm.pt", "inter", "an InterRM model", "--inter-model");
-    o.threads = c.threads;
-    inter_ = std::make_unique<relation::InterRM>(o);
-    desc << "; InterRM " << o.model_path;
+    const std::string path =
+        resolveModel(c.inter_model, c.models, "inter_rm.pt", "inter", "an InterRM model", "--inter-model");
+    inter_ = loadModule<relation::InterRM, relation::InterRMOptions>(path, c.threads);
+    desc << "; InterRM " << path;
   }
   if (has(stages_, "track") || has(stages_, "inter")) {
     // Unset: the nodelets' config for the LWD-3D detector's probabilities; TrackerOptions' (PointRCNN) otherwise.
-    // (packagePath() asks rospack, which complains on stderr without the package: only when needed.)
     const std::string config = !c.tracker_config.empty() ? c.tracker_config
-                               : hasBase()              ? defaultTrackerConfig(stages_, packagePath())
+                               : hasBase()              ? defaultTrackerConfig(stages_, c.package_dir)
                                                         : "";
-    TrackerOptions t = config.empty() ? TrackerOptions{} : loadTrackerOptions(config);
-    // As in the ROS pipeline (the InterRM nodelet keeps max_history boxes per track), the history InterRM sees is
-    // its model's max_history, whatever the tracker config says.
-    if (inter_) t.history_length = inter_->arch().max_history;
-    history_length_ = t.history_length;
-    tracking_ = std::make_unique<train::TrackingRefiner>(t, inter_.get());
+    const TrackerOptions t = config.empty() ? TrackerOptions{} : loadTrackerOptions(config);
+    tracking_ = std::make_unique<TrackRefiner>(t, inter_.get());
+    history_length_ = inter_ ? static_cast<int>(tracking_->historyLength()) : t.history_length;
     desc << "; tracker " << (config.empty() ? "built-in defaults (config/tracker.yaml's values)" : config);
     if (c.tracker_config.empty()) desc << (config.empty() ? ", for external detections" : ", the base stage's default");
   }
@@ -176,5 +174,5 @@ Detections OfflinePipeline::run(const PointCloud* current, const PointCloud* pre
   return d;
 }
 
-}  // namespace tools
+}  // namespace pipeline
 }  // namespace ret3d

@@ -1,0 +1,22 @@
+#include "tools/pipeline_options.h"
+
+#include "ret3d/ros/params.h"
+
+namespace ret3d {
+namespace tools {
+
+void addGridExtentOption(CLI::App& app, std::vector<double>* extent) {
+  app.add_option("--grid-extent", *extent,
+                 "run the detector over this grid, x_min,x_max,y_min,y_max in m (e.g. --grid-extent=-80,80,-48,48; "
+                 "default: the model's); the cost grows with the area")
+      ->delimiter(',')
+      ->expected(4);
+}
+
+pipeline::PipelineConfig withPackageDir(pipeline::PipelineConfig config) {
+  if (pipeline::usesPackageDir(config)) config.package_dir = packagePath();
+  return config;
+}
+
+}  // namespace tools
+}  // namespace ret3d
