@@ -85,7 +85,7 @@ model="$OUT/$best.pt"
 # the schedule), then lwd3d_<head>_stage3.yaml (6 more from stage 2's, half the rate, another seed). A stage's model
 # is installed when it validates better than the best so far.
 stage() {  # stage-name init-model [extra ret3d train detector options]
-  local name="${best_head}_$1" init=$2
+  local step=$1 name="${best_head}_$1" init=$2
   shift 2
   [ -f "config/detector/lwd3d_$name.yaml" ] || return 0
   if [ ! -f "$OUT/$name.done" ]; then
@@ -95,11 +95,11 @@ stage() {  # stage-name init-model [extra ret3d train detector options]
       --config "config/detector/lwd3d_$name.yaml" --init "$init" --out "$OUT/$name.pt" \
       --threads 2 --resume "$@" >"$OUT/train_$name.log" 2>&1
     touch "$OUT/$name.done"
-    echo "$1 took $(( ($(date +%s) - t0) / 60 )) min (this run)"
+    echo "$step took $(( ($(date +%s) - t0) / 60 )) min (this run)"
   fi
   ap=$(validate "$name" "$OUT/$name.pt")
-  echo "$best_head head after $1: mean 3D AP R40 moderate on the validation set $ap"
-  if better "$ap" "$best_ap"; then model="$OUT/$name.pt"; best="$best_head head, $1"; best_ap=$ap; fi
+  echo "$best_head head after $step: mean 3D AP R40 moderate on the validation set $ap"
+  if better "$ap" "$best_ap"; then model="$OUT/$name.pt"; best="$best_head head, $step"; best_ap=$ap; fi
 }
 best_head=$best
 stage stage2 "$OUT/$best_head.pt"
