@@ -490,7 +490,8 @@ CommandRegistrar reg("bench", "time the pipeline: through the nodelets on a bag,
   app.add_option("--tracker-config", p.tracker_config,
                  "tracker YAML (default: config/tracker_lwd3d_pipeline.yaml with the base stage, as the "
                  "nodelets; without it config/tracker.yaml's values, built in; --bag: the one config/ret3d.yaml names)");
-  app.add_option("--score-threshold", p.score_threshold, "detector score threshold (default: the model's; --bag: config/ret3d.yaml's)");
+  app.add_option("--score-threshold", p.score_threshold, "the lowest score the detector publishes (default: with the track stage or --bag "
+                 "config/ret3d.yaml's; otherwise the model's)");
   addGridExtentOption(app, &p.grid_extent);
   app.add_option("--stages", a->stages, "comma-separated stages in order, starting with base")->capture_default_str();
   app.add_option("--threads", p.threads, "CPU threads for libtorch")->capture_default_str();
