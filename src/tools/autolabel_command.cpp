@@ -254,8 +254,7 @@ CommandRegistrar reg("autolabel", "pseudo-labels for unlabelled sequences: pipel
                  "tracker YAML (default: config/tracker_lwd3d_pipeline.yaml, as the nodelets)");
   app.add_option("--stages", a->stages, "comma-separated pipeline stages: base first, track or inter needed")
       ->capture_default_str();
-  app.add_option("--score-threshold", p.score_threshold, "the lowest score the detector publishes (default: with the track stage config/ret3d.yaml's, as the "
-                 "nodelets feed their tracker; otherwise the model's)");
+  addScoreThresholdOption(app, &p.score_threshold);
   addGridExtentOption(app, &p.grid_extent);
   app.add_option("--sequences", a->sequences, "tracking sequences, e.g. 0-3 (default: all)");
   app.add_option("--min-track-length", s.min_track_length, "drop tracks seen in fewer frames")->capture_default_str();

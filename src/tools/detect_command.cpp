@@ -256,8 +256,7 @@ CommandRegistrar reg("detect", "run the pipeline offline (base detector, IntraRM
   app.add_option("--detector-model", p.detector_model, "detector model file (overrides --models)");
   app.add_option("--detector-config", p.detector_config,
                  "detector YAML for inference options (default: the config stored in the model file)");
-  app.add_option("--score-threshold", p.score_threshold, "the lowest score the detector publishes (default: with the track stage config/ret3d.yaml's, as the "
-                 "nodelets feed their tracker; otherwise the model's)");
+  addScoreThresholdOption(app, &p.score_threshold);
   addGridExtentOption(app, &p.grid_extent);
   app.add_option("--intra-model", p.intra_model, "IntraRM model file (overrides --models)");
   app.add_option("--inter-model", p.inter_model, "InterRM model file (overrides --models)");

@@ -13,6 +13,12 @@ void addGridExtentOption(CLI::App& app, std::vector<double>* extent) {
       ->expected(4);
 }
 
+void addScoreThresholdOption(CLI::App& app, double* threshold) {
+  app.add_option("--score-threshold", *threshold,
+                 "the lowest score the detector publishes (default: with the track stage config/ret3d.yaml's, as the "
+                 "nodelets feed their tracker; otherwise the model's)");
+}
+
 pipeline::PipelineConfig withPackageDir(pipeline::PipelineConfig config) {
   if (pipeline::usesPackageDir(config)) config.package_dir = packagePath();
   return config;

@@ -14,6 +14,9 @@ namespace tools {
 // The --grid-extent option of the commands that run the detector (x_min,x_max,y_min,y_max in metres).
 void addGridExtentOption(CLI::App& app, std::vector<double>* extent);
 
+// The --score-threshold option of the commands that run the pipeline (PipelineConfig::score_threshold).
+void addScoreThresholdOption(CLI::App& app, double* threshold);
+
 // `config` with the package folder filled in when the pipeline needs it (pipeline::usesPackageDir). Only then: the
 // look-up asks rospack, which complains on stderr when the package is not on ROS_PACKAGE_PATH.
 pipeline::PipelineConfig withPackageDir(pipeline::PipelineConfig config);
