@@ -294,7 +294,7 @@ std::vector<std::size_t> epochOrder(const DetectorDataset& data, unsigned seed, 
   return order;
 }
 
-void augmentSample(DetectorSample* s, const TrainOptions& t, std::mt19937* rng) {
+void augmentSample(DetectorSample* s, const TrainOptions& t, const BevGeometry& grid, std::mt19937* rng) {
   std::uniform_real_distribution<double> U(0.0, 1.0);
   if (s->has_previous && !s->prev_to_current.isApprox(Eigen::Isometry3d::Identity())) {
     s->previous = transformCloud(s->previous, s->prev_to_current);
@@ -362,17 +362,23 @@ void augmentSample(DetectorSample* s, const TrainOptions& t, std::mt19937* rng) 
     s->boxes = std::move(boxes);
     s->velocity_valid = std::move(valid);
   };
-  // Random clipping: keep a random window covering 60-100 % of each side of a 100 m square.
+  // Random clipping: keep a random window covering 60-100 % of each side of the grid grown by 2 m on every side (a
+  // 100 m square for the +-48 m grid). It once was that square whatever the grid, which cut every object beyond 50 m
+  // out of 30 % of a +-80 m grid's samples.
   if (U(*rng) < t.crop_probability) {
-    const double wx = 100 * (0.6 + 0.4 * U(*rng)), wy = 100 * (0.6 + 0.4 * U(*rng));
-    const double x0 = -50 + (100 - wx) * U(*rng), y0 = -50 + (100 - wy) * U(*rng);
+    const double sx = grid.x_max - grid.x_min + 4, sy = grid.y_max - grid.y_min + 4;
+    const double wx = sx * (0.6 + 0.4 * U(*rng)), wy = sy * (0.6 + 0.4 * U(*rng));
+    const double x0 = grid.x_min - 2 + (sx - wx) * U(*rng), y0 = grid.y_min - 2 + (sy - wy) * U(*rng);
     filter([=](double x, double y) { return x >= x0 && x < x0 + wx && y >= y0 && y < y0 + wy; });
   }
-  // Block input: blank one to three random squares (2-8 m), as occlusions do.
+  // Block input: blank one to three random squares (2-8 m), as occlusions do, centred anywhere on the grid but its
+  // outer 8 m.
   if (U(*rng) < t.block_probability) {
     const int n = 1 + static_cast<int>(U(*rng) * 3);
+    const double bx = grid.x_max - grid.x_min - 16, by = grid.y_max - grid.y_min - 16;
     std::vector<std::array<double, 3>> blocks;
-    for (int k = 0; k < n; ++k) blocks.push_back({-40 + 80 * U(*rng), -40 + 80 * U(*rng), 1 + 3 * U(*rng)});
+    for (int k = 0; k < n; ++k)
+      blocks.push_back({grid.x_min + 8 + bx * U(*rng), grid.y_min + 8 + by * U(*rng), 1 + 3 * U(*rng)});
     filter([=](double x, double y) {
       for (const auto& b : blocks)
         if (std::abs(x - b[0]) < b[2] && std::abs(y - b[1]) < b[2]) return false;

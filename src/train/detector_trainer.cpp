@@ -171,7 +171,7 @@ DetectorTrainResult trainDetector(const DetectorTrainJob& job) {
         if (pos >= order.size()) break;
         DetectorSample s = data.load(order[pos]);
         sensor_augment.apply(&s, &rng);  // draws nothing while its options are off
-        augmentSample(&s, t, &rng);
+        augmentSample(&s, t, o.model.geometry, &rng);
         const BevImage img = encoder.encode(s.current, s.has_previous ? &s.previous : nullptr, s.prev_to_current);
         inputs.push_back(nn::bevToTensor(img));
         nn::GroundTruth gt;

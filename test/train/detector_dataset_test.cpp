@@ -186,7 +186,7 @@ TEST(DetectorDataset, TheViewFollowsTheAugmentation) {
   std::mt19937 rng(5);
   for (int k = 0; k < 10; ++k) {
     DetectorSample s = data.load(0);
-    augmentSample(&s, t, &rng);
+    augmentSample(&s, t, ModelConfig().geometry, &rng);
     ASSERT_TRUE(s.labelled_view.has_value());
     for (const Box& b : s.boxes) EXPECT_TRUE(s.labelled_view->contains({b.x, b.y})) << k;
     for (const Box& b : s.boxes)
@@ -195,6 +195,36 @@ TEST(DetectorDataset, TheViewFollowsTheAugmentation) {
 }
 
 // The loss itself: a confident prediction behind the camera costs nothing on a camera-view set, one ahead does.
+// Random clipping is drawn over the model's grid: on a +-80 m grid a car at 70 m is kept by some clips (a long-range
+// model learns far objects), while the +-48 m grid's clips never reach it.
+TEST(DetectorDataset, ClippingCoversTheWholeGrid) {
+  TrainOptions t;
+  t.crop_probability = 1, t.block_probability = 0;
+  t.rotation_range = 0, t.flip = false, t.scale_min = t.scale_max = 1;
+  Box car;
+  car.label = ObjectClass::Car, car.x = 70, car.y = 5, car.z = -0.9, car.length = 4.2, car.width = 1.8, car.height = 1.5;
+  auto keptOf = [&](const BevGeometry& grid) {
+    std::mt19937 rng(11);
+    int kept = 0;
+    for (int k = 0; k < 40; ++k) {
+      DetectorSample s;
+      for (int i = 0; i < 20; ++i) s.current.push_back(Point{70.0f + 0.1f * i, 5.0f, -1.0f, 0.3f});
+      s.boxes = {car};
+      s.velocity_valid = {true};
+      augmentSample(&s, t, grid, &rng);
+      if (!s.boxes.empty())
+        ++kept;
+      else
+        EXPECT_EQ(s.ignore.size(), 1u);  // a clipped object is ignored, not taught as background
+    }
+    return kept;
+  };
+  BevGeometry wide = ModelConfig().geometry;
+  wide.x_min = -80, wide.x_max = 80;
+  EXPECT_GT(keptOf(wide), 10);
+  EXPECT_EQ(keptOf(ModelConfig().geometry), 0);
+}
+
 TEST(DetectorDataset, NoLossOutsideTheCameraViewInEitherHead) {
   ObjectSet set;
   DetectorDataset data(set.dir.path(), ModelConfig());

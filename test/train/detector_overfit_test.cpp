@@ -293,7 +293,7 @@ TEST(DetectorDataset, AugmentationMovesPointsAndBoxesTogether) {
   o.train.scale_min = 0.9, o.train.scale_max = 1.1;
   o.train.flip = true;
   std::mt19937 rng(4);
-  augmentSample(&s, o.train, &rng);
+  augmentSample(&s, o.train, o.model.geometry, &rng);
   // Every object keeps the points that were inside it (boxes lifted off the ground plane, whose points lie on
   // their bottom faces, so boundary rounding does not count).
   auto lifted = [](std::vector<Box> boxes) {

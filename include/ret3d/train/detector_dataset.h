@@ -100,7 +100,8 @@ std::vector<std::size_t> epochOrder(const DetectorDataset& data, unsigned seed, 
 
 // Augmentation (LWD-3D §2.5: rotation, clipping, block input; plus flip and scaling). The previous sweep is first
 // moved into the current frame (prev_to_current becomes identity), so every transform applies to both sweeps alike.
-void augmentSample(DetectorSample* s, const TrainOptions& t, std::mt19937* rng);
+// Clipping and block input are drawn over `grid` (the model's configured grid, not a batch's multi-scale crop).
+void augmentSample(DetectorSample* s, const TrainOptions& t, const BevGeometry& grid, std::mt19937* rng);
 
 // The grid of one training batch under the multi-scale schedule (LWD-3D eq. (4)): side 32 (base + n) cells, centred
 // where the configured grid is centred; the configured grid when the schedule is off.
