@@ -90,7 +90,7 @@ std::unique_ptr<DetectorModel> DetectorModel::load(const std::string& path, cons
 }
 
 std::unique_ptr<DetectorModel> DetectorModel::extend(const std::string& path, const ModelConfig& config,
-                                                     std::vector<std::string>* fresh) {
+                                                     std::vector<std::string>* fresh, bool other_cell_size) {
   auto from = load(path);
   ModelConfig base = config;
   base.anchor.iou_quality = from->config().anchor.iou_quality;
@@ -100,6 +100,7 @@ std::unique_ptr<DetectorModel> DetectorModel::extend(const std::string& path, co
   base.geometry.x_max = fg.x_max;
   base.geometry.y_min = fg.y_min;
   base.geometry.y_max = fg.y_max;
+  if (other_cell_size) base.geometry.resolution = fg.resolution;
   const auto diffs = diffModelConfigs(from->config(), base);
   if (!diffs.empty() || (from->config().anchor.iou_quality && !config.anchor.iou_quality)) {
     std::string msg = path + ": cannot start the configured model from this file:";

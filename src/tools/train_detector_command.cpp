@@ -39,6 +39,9 @@ CommandRun setup(CLI::App& app) {
                  "start from this model's weights (same model config, or one that adds the IoU channels) with a fresh "
                  "optimiser and schedule; --resume still wins when <out>.ckpt exists")
       ->check(CLI::ExistingFile);
+  app.add_flag("--init-other-cells", job->init_other_cells,
+               "--init: the model file may have another cell size (model.bev.resolution); its weights are then only a "
+               "starting point, e.g. for a coarser long-range grid");
   auto gt_database = std::make_shared<std::string>();
   app.add_option("--gt-database", *gt_database,
                  "ground-truth sampling database (`ret3d train gtdb`; overrides train.gt_database)")

@@ -121,7 +121,7 @@ DetectorTrainResult trainDetector(const DetectorTrainJob& job) {
     // The config's model part must match the file's, or only add outputs (extend() refuses otherwise); the anchors
     // come from the file.
     std::vector<std::string> fresh;
-    model = nn::DetectorModel::extend(job.init_model, o.model, &fresh);
+    model = nn::DetectorModel::extend(job.init_model, o.model, &fresh, job.init_other_cells);
     RET3D_INFO("starting from the weights of " << job.init_model << " (fresh optimiser and schedule)");
     for (const std::string& name : fresh) RET3D_INFO("  " << name << ": new outputs start freshly initialised");
   } else {

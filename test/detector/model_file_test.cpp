@@ -178,9 +178,13 @@ TEST(ModelFile, AModelCoversAWiderGridThanItWasTrainedOn) {
   const auto x = torch::rand({1, 6, 128, 256});
   const auto a = file->forward(x), b = started->forward(x);
   for (const auto& [stride, out] : a.head) EXPECT_TRUE(torch::equal(b.head.at(stride), out)) << "stride " << stride;
-  // Another cell size is another network input: refused.
+  // Another cell size is another network input: refused, unless asked for (a start for training on coarser cells).
   wide.geometry.resolution = 0.5;
   EXPECT_THROW(nn::DetectorModel::extend(path, wide), ModelFileError);
+  auto coarse = nn::DetectorModel::extend(path, wide, &fresh, true);
+  EXPECT_TRUE(fresh.empty());
+  EXPECT_EQ(coarse->config().geometry.width(), 128);
+  EXPECT_DOUBLE_EQ(coarse->config().geometry.resolution, 0.5);
 }
 
 TEST(ModelFile, TruncatedOrCorruptFilesAreRefused) {

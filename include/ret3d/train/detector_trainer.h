@@ -22,6 +22,7 @@ struct DetectorTrainJob {
   bool resume = false;
   std::string init_model;     // when set (and not resuming): start from this model's weights and anchors, with a
                               // fresh optimiser and learning-rate schedule (a second, fine-tuning stage)
+  bool init_other_cells = false;  // init_model may have another cell size (DetectorModel::extend)
   bool progress = true;       // draw the progress bar
 };
 

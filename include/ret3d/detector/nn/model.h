@@ -31,9 +31,11 @@ class DetectorModel {
   // `config` adds (anchor.iou_quality turned on) and by the grid's extent (the cells, heights and network the same:
   // it is fully convolutional): every tensor of the file is copied, a head layer that gained output
   // channels gets the file's in its leading ones. `fresh` (optional) receives the names of tensors not (fully)
-  // copied. Throws ModelFileError for any other difference.
+  // copied. Throws ModelFileError for any other difference. With other_cell_size the cell size may differ too: the
+  // same network on cells of another size sees every object at another scale, so the weights are then a starting
+  // point for training, never a model to run as it is.
   static std::unique_ptr<DetectorModel> extend(const std::string& path, const ModelConfig& config,
-                                               std::vector<std::string>* fresh = nullptr);
+                                               std::vector<std::string>* fresh = nullptr, bool other_cell_size = false);
   // trained_with: the full config text of the run, stored for the record.
   void save(const std::string& path, const std::string& trained_with = "") const;
 
