@@ -10,7 +10,8 @@
 #      models/lwd3d/detector.pt, with config/detector/lwd3d_anchor_robust.yaml: real train split (labels cover camera
 #      2's view only, so no loss outside it) and simulated sets (labels all around);
 #   4. evaluates on the val split: `ret3d detect --stages base`, `ret3d eval --metric kitti --kitti-recall devkit`
-#      on every box and on the boxes in the camera's view (as scripts/real_scans.sh), prints the moderate AP;
+#      on every box and on the boxes in the camera's view (as scripts/experiments/real_scans.sh), prints the moderate
+#      AP;
 #   5. installs the model into --install DIR when asked.
 # Resumable and idempotent: run it again after a stop and it continues from the last checkpoint; finished steps are
 # skipped (markers OUT/*.done). Nothing is downloaded.
@@ -166,14 +167,14 @@ if ((n_train != 3712 || n_val != 3769)); then
   echo "$ME: warning: the split has $n_train train / $n_val val frames, not the standard 3,712 / 3,769" >&2
 fi
 
-# Those six frames are frames of the full set too: in its train half, a model learnt them, and scripts/real_scans.sh
-# (which evaluates on them) no longer measures it on unseen scans.
+# Those six frames are frames of the full set too: in its train half, a model learnt them, and
+# scripts/experiments/real_scans.sh (which evaluates on them) no longer measures it on unseen scans.
 if [ -d "$SHARED_KITTI/velodyne" ]; then
   seen=$(comm -12 <(ids "$SPLIT_DIR/train.txt" | sort -u) \
     <(find "$SHARED_KITTI/velodyne" -maxdepth 1 -name '*.bin' -printf '%f\n' | sed 's/\.bin$//' | sort -u) |
     paste -sd ' ')
-  [ -z "$seen" ] || echo "$ME: note: frames $seen of the project's validation set ($SHARED_KITTI) are in" \
-                         "train.txt: scripts/real_scans.sh figures of this model are not on unseen scans" >&2
+  [ -z "$seen" ] || echo "$ME: note: frames $seen of the project's validation set ($SHARED_KITTI) are in train.txt:" \
+                         "scripts/experiments/real_scans.sh figures of this model are not on unseen scans" >&2
 fi
 
 mkdir -p "$OUT"
@@ -319,7 +320,7 @@ if [ ! -f "$OUT/val.done" ]; then
   ret3d detect --data "$REAL/val" --detector-model "$MODEL" --stages base --out "$VAL/pred" --threads "$THREADS" \
     >"$VAL/detect.log" 2>&1 || { tail -20 "$VAL/detect.log" >&2; die "ret3d detect failed (log: $VAL/detect.log)"; }
   # The labels cover camera 2's image only and the detector sees all around: keep the boxes whose 2D box (fields
-  # 5-8, clipped to the image by `ret3d detect`) overlaps the image, as scripts/real_scans.sh.
+  # 5-8, clipped to the image by `ret3d detect`) overlaps the image, as scripts/experiments/real_scans.sh.
   mkdir -p "$VAL/pred_camera_view"
   for f in "$VAL"/pred/*.txt; do
     [ -f "$f" ] || continue  # no result files at all: the evaluations below count every object missed

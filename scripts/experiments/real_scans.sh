@@ -3,12 +3,12 @@
 # labelled KITTI object frames of ../shared/data, `ret3d eval` (KITTI AP) on them, and bird's-eye-view pictures with
 # `ret3d draw`: docs/real_<frame>.png (ground truth white, detections by class) for the four labelled frames and
 # docs/real_unlabeled_<n>.png for three unlabeled scans. The data is read in place, never copied.
-# Usage: scripts/real_scans.sh [MODELS_DIR]          (default models/lwd3d; MODELS_DIR/detector.pt is used)
+# Usage: scripts/experiments/real_scans.sh [MODELS_DIR]          (default models/lwd3d; MODELS_DIR/detector.pt is used)
 # Environment: RET3D (the binary; default build/devel/bin/ret3d), RET3D_SHARED_DATA (default ../shared/data),
 #   OUT (default out/real_scans), DOCS (default docs), SCORE_THRESHOLD (default: the model's own),
 #   UNLABELED (scan numbers, default "000000 000010 000021").
 set -euo pipefail
-ROOT=$(cd "$(dirname "$0")/.." && pwd)
+ROOT=$(cd "$(dirname "$0")/../.." && pwd)
 MODELS=${1:-$ROOT/models/lwd3d}
 RET3D=${RET3D:-$ROOT/build/devel/bin/ret3d}
 DATA=${RET3D_SHARED_DATA:-$ROOT/../shared/data}

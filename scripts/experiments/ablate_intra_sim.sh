@@ -2,15 +2,15 @@
 # IntraRM on this package's detector, simulated data (Ret3D Tables 3, 5, 6 analogues):
 #   trains every config/relation/intra_lwd3d*.yaml on the default detector's boxes and features over the relation
 #   set (urban, seeds 3000-3011: sequences 0-9 train, 10-11 validation), then runs base + IntraRM on the held-out set
-#   (scripts/eval_heldout.sh: urban seeds 9000-9004, 500 frames), prints one row per configuration and writes the
-#   table between the intra-sim-ablation markers of docs/RESULTS.md.
-#   scripts/ablate_intra_sim.sh [CONFIGS...]     (default: all; two trainings at a time, one thread each)
+#   (scripts/experiments/eval_heldout.sh: urban seeds 9000-9004, 500 frames), prints one row per configuration and
+#   writes the table between the intra-sim-ablation markers of docs/RESULTS.md.
+#   scripts/experiments/ablate_intra_sim.sh [CONFIGS...]     (default: all; two trainings at a time, one thread each)
 # Environment: DETECTOR (default models/lwd3d/detector.pt); RELATION_DATA (the relation set, default
 # data/sim_relation_urban, simulated when missing with seeds 3000-3011); HELDOUT_SEED (another held-out set, as
-# scripts/eval_heldout.sh: a fresh one for a new detector).
+# scripts/experiments/eval_heldout.sh: a fresh one for a new detector).
 # Work files: out/ablate_intra_sim/.
 set -eo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 set +u
 source scripts/env.sh
 set -u
@@ -36,12 +36,13 @@ train() {  # config
     --config "config/relation/$1.yaml" --sequences 0-9 --val-sequences 10-11 --out "$OUT/$1.pt" --threads 1 --quiet \
     >"$OUT/$1.train.log" 2>&1
 }
-source scripts/two_at_a_time.sh
+source scripts/experiments/two_at_a_time.sh
 two_at_a_time train "${CONFIGS[@]}"
 
-[ -f out/heldout/base/eval/metrics.json ] || scripts/eval_heldout.sh base base --detector-model "$DET" >/dev/null
+[ -f out/heldout/base/eval/metrics.json ] ||
+  scripts/experiments/eval_heldout.sh base base --detector-model "$DET" >/dev/null
 for c in "${CONFIGS[@]}"; do
   [ -f "out/heldout/$c/eval/metrics.json" ] ||
-    scripts/eval_heldout.sh base,intra "$c" --detector-model "$DET" --intra-model "$OUT/$c.pt" >/dev/null
+    scripts/experiments/eval_heldout.sh base,intra "$c" --detector-model "$DET" --intra-model "$OUT/$c.pt" >/dev/null
 done
-python3 scripts/results_table.py intra "$OUT" "${CONFIGS[@]}"
+python3 scripts/experiments/results_table.py intra "$OUT" "${CONFIGS[@]}"

@@ -3,19 +3,20 @@
 # 0001-0020: for each fold, trains IntraRM (config/relation/intra_rm.yaml, as models/kitti_pointrcnn/intra_rm.pt) on
 # the other sequences, then scores the held-out fold's PointRCNN boxes three ways (base = unchanged boxes through the
 # same conversions, + the fold's IntraRM, + the shipped intra_rm.pt, which was trained on 0001-0015) and evaluates
-# KITTI 3D AP R40 moderate with `ret3d eval`. scripts/loso_intra_kitti_summary.py then writes a table per fold, the
-# mean / std / sign count of the gain per class, and a pooled evaluation of all held-out predictions at once.
+# KITTI 3D AP R40 moderate with `ret3d eval`. scripts/experiments/loso_intra_kitti_summary.py then writes a table per
+# fold, the mean / std / sign count of the gain per class, and a pooled evaluation of all held-out predictions at once.
 # A measurement only: nothing is tuned.
 #
-#   scripts/loso_intra_kitti.sh
-#   FOLDS="1-4 5-8 9-12 13-16 17-20" scripts/loso_intra_kitti.sh     (default: leave-one-sequence-out, 1 .. 20)
+#   scripts/experiments/loso_intra_kitti.sh
+#   FOLDS="1-4 5-8 9-12 13-16 17-20" scripts/experiments/loso_intra_kitti.sh
+#   (default: leave-one-sequence-out, 1 .. 20)
 #
 # Env: RET3D (binary, default build/devel/bin/ret3d), RET3D_SHARED_DATA (default ../shared/data), THREADS (1),
 # FOLDS (space-separated --sequences specs), CONFIG (IntraRM YAML, default config/relation/intra_rm.yaml; e.g. another
 # seed to see the training noise), OUT (default out/loso_intra_kitti; fold_*/ work folders, summary.md for the default
 # folds, summary_<K>folds.md otherwise). Resumable: steps whose results exist are skipped.
 set -euo pipefail
-ROOT="$(cd "$(dirname "$0")/.." && pwd)"
+ROOT="$(cd "$(dirname "$0")/../.." && pwd)"
 RET3D="${RET3D:-$ROOT/build/devel/bin/ret3d}"
 SHARED="${RET3D_SHARED_DATA:-$ROOT/../shared/data}"
 DATA="$SHARED/kitti_tracking"
@@ -91,6 +92,7 @@ for name in base intra shipped; do
   fi
 done
 
-/usr/bin/python3 "$ROOT/scripts/loso_intra_kitti_summary.py" --out "$OUT" --pooled "$pooled" --labels "$DATA/training/label_02" \
-  --shipped-train "$SHIPPED_TRAIN" --summary "$summary" --config "$CONFIG" --folds $FOLDS
+/usr/bin/python3 "$ROOT/scripts/experiments/loso_intra_kitti_summary.py" --out "$OUT" --pooled "$pooled" \
+  --labels "$DATA/training/label_02" --shipped-train "$SHIPPED_TRAIN" --summary "$summary" --config "$CONFIG" \
+  --folds $FOLDS
 echo "done in $(( $(date +%s) - start_all )) s; summary: $summary"

@@ -3,11 +3,12 @@
 # KITTI tracking sequences 0001-0015, refines the boxes of 0016-0020 with it, evaluates KITTI 3D AP (R40) with
 # `ret3d eval`, and writes the table between the intra-ablation markers of docs/RESULTS.md.
 #
-#   scripts/ablate_intra.sh [BUILD_DIR]        (default build/; configs to run: CONFIGS="intra_rm intra_no_edge ...")
+#   scripts/experiments/ablate_intra.sh [BUILD_DIR]
+#   (default build/; configs to run: CONFIGS="intra_rm intra_no_edge ...")
 #
 # Needs the shared KITTI-derived data (../shared/data, or RET3D_SHARED_DATA). Work files go to out/ablate_intra/.
 set -euo pipefail
-ROOT="$(cd "$(dirname "$0")/.." && pwd)"
+ROOT="$(cd "$(dirname "$0")/../.." && pwd)"
 BUILD="${1:-$ROOT/build}"
 RET3D="$BUILD/devel/bin/ret3d"
 SHARED="${RET3D_SHARED_DATA:-$ROOT/../shared/data}"
@@ -65,7 +66,8 @@ import sys, datetime
 path, rows, train, test = sys.argv[1:5]
 begin, end = "<!-- intra-ablation:begin -->", "<!-- intra-ablation:end -->"
 table = ("Trained on PointRCNN boxes of sequences %s, evaluated on %s (KITTI 3D AP, R40, moderate; %s UTC; "
-         "`scripts/ablate_intra.sh`).\n\n" % (train, test, datetime.datetime.utcnow().strftime("%Y-%m-%d %H:%M"))
+         "`scripts/experiments/ablate_intra.sh`).\n\n"
+         % (train, test, datetime.datetime.utcnow().strftime("%Y-%m-%d %H:%M"))
          + "| configuration | Car | Pedestrian | Cyclist | mean | train s | IntraRM ms/frame |\n"
          + "| --- | --- | --- | --- | --- | --- | --- |\n" + open(rows).read())
 text = open(path).read() if __import__("os").path.exists(path) else "# Results\n"

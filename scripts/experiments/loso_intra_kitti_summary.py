@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
-"""Summary table of scripts/loso_intra_kitti.sh: per fold KITTI 3D AP R40 moderate of the base PointRCNN boxes,
-+ the fold's IntraRM and + the shipped intra_rm.pt, label counts, and per class the mean / std / sign count of the
-gain over the folds that have moderate ground truth of that class."""
+"""Summary table of scripts/experiments/loso_intra_kitti.sh: per fold KITTI 3D AP R40 moderate of the base PointRCNN
+boxes, + the fold's IntraRM and + the shipped intra_rm.pt, label counts, and per class the mean / std / sign count of
+the gain over the folds that have moderate ground truth of that class."""
 import argparse
 import datetime
 import json
@@ -130,8 +130,8 @@ def main():
     pooled = {n: metrics(os.path.join(a.pooled, "eval_" + n)) for n in ("base", "intra", "shipped")}
     out = []
     out.append("# IntraRM on PointRCNN boxes: cross-validation over KITTI tracking 0001-0020\n")
-    out.append("`scripts/loso_intra_kitti.sh` (%s UTC). %d folds; each fold's IntraRM trained on the other sequences "
-               "of 0001-0020 with %s; %d-%d s per training, 1 thread. "
+    out.append("`scripts/experiments/loso_intra_kitti.sh` (%s UTC). %d folds; each fold's IntraRM trained on the "
+               "other sequences of 0001-0020 with %s; %d-%d s per training, 1 thread. "
                "KITTI 3D AP R40 moderate (Car @0.7, Pedestrian / Cyclist @0.5) from `ret3d eval`'s metrics.json. "
                "Counts: labelled objects (boxes over all frames) / tracks / moderate ground-truth boxes the AP counts. "
                "A class without moderate ground truth in a fold is left out of that fold's statistics.\n"

@@ -4,11 +4,11 @@
 # `ret3d eval` on it for every pair of box-voting IoU
 # (inference.nms_voting_iou) and IoU-score power (inference.iou_score_power) below and prints the mean of the three
 # classes' 3D AP R40 moderate (the criterion scripts/train_default.sh selects models by), best last.
-#   scripts/tune_inference.sh MODEL CONFIG [VOTING_LIST] [POWER_LIST]
-#   scripts/tune_inference.sh out/train_default/anchor_stage2.pt config/detector/lwd3d_anchor_stage2.yaml
+#   scripts/experiments/tune_inference.sh MODEL CONFIG [VOTING_LIST] [POWER_LIST]
+#   scripts/experiments/tune_inference.sh out/train_default/anchor_stage2.pt config/detector/lwd3d_anchor_stage2.yaml
 # CONFIG: the model's YAML; only its inference values are varied. Work goes to out/tune_inference/.
 set -eo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 MODEL=${1:?model file}
 CONFIG=${2:?detector config YAML of the model}
 VOTING=${3:-0 0.3 0.5 0.65}

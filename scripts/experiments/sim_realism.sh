@@ -4,11 +4,11 @@
 # and points on cars against distance, for simulated urban HDL-64E scans and the real KITTI scans of ../shared/data
 # (read in place, never copied), with the Wasserstein-1 distance of each statistic (ret3d sim --compare) in the panel
 # titles and in $OUT/sim_w1.txt.
-# Usage: [BEFORE_REV=<git revision>] scripts/sim_realism.sh [RET3D_BINARY]
+# Usage: [BEFORE_REV=<git revision>] scripts/experiments/sim_realism.sh [RET3D_BINARY]
 #   BEFORE_REV: also simulate with the presets (config/sim/urban_street.yaml, config/sensors/hdl64e.yaml) of that
 #   revision, with this binary (knobs a preset does not name are off), and plot and compare it as "before".
 set -euo pipefail
-ROOT=$(cd "$(dirname "$0")/.." && pwd)
+ROOT=$(cd "$(dirname "$0")/../.." && pwd)
 RET3D=${1:-$ROOT/build/devel/bin/ret3d}
 DATA=${RET3D_SHARED_DATA:-$ROOT/../shared/data}
 OUT=${OUT:-$ROOT/out/sim_realism}

@@ -3,15 +3,15 @@
 #   trains InterRM for every history length N (config/relation/inter_lwd3d.yaml with max_history N) and every
 #   positional encoding (config/relation/inter_lwd3d_pe_*.yaml, N = the shipped one) on the default models' boxes
 #   over the relation set (urban, seeds 3000-3011: sequences 0-9 train, 10-11 validation), then runs
-#   base + IntraRM + the pipeline's tracker + InterRM on the held-out set (scripts/eval_heldout.sh: urban
+#   base + IntraRM + the pipeline's tracker + InterRM on the held-out set (scripts/experiments/eval_heldout.sh: urban
 #   seeds 9000-9004, 500 frames) and times tracker + InterRM for 50 tracks with full histories (`ret3d bench`).
 #   Prints one row per configuration and writes the tables between the inter-sim-history and inter-sim-pe markers
 #   of docs/RESULTS.md, and the Table 3 analogue (table3-sim markers) with the shipped history length.
-#   scripts/ablate_inter_sim.sh            (two trainings at a time, one thread each; ~1 min per training)
-#   HISTORIES="1 10 30" scripts/ablate_inter_sim.sh
+#   scripts/experiments/ablate_inter_sim.sh            (two trainings at a time, one thread each; ~1 min per training)
+#   HISTORIES="1 10 30" scripts/experiments/ablate_inter_sim.sh
 # Work files: out/ablate_inter_sim/. Needs models/lwd3d/{detector,intra_rm}.pt.
 set -eo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 set +u
 source scripts/env.sh
 set -u
@@ -46,25 +46,26 @@ train() {  # name
     --intra-model "$MODELS/intra_rm.pt" --tracker-config "$TRACKER" --config "$OUT/configs/$1.yaml" \
     --sequences 0-9 --val-sequences 10-11 --out "$OUT/$1.pt" --threads 1 --quiet >"$OUT/$1.train.log" 2>&1
 }
-source scripts/two_at_a_time.sh
+source scripts/experiments/two_at_a_time.sh
 two_at_a_time train "${NAMES[@]}"
 
 MODEL_FLAGS=(--detector-model "$MODELS/detector.pt" --intra-model "$MODELS/intra_rm.pt")
 [ -f out/heldout/sim_intra_track/eval/metrics.json ] ||
-  scripts/eval_heldout.sh base,intra,track sim_intra_track "${MODEL_FLAGS[@]}" --tracker-config "$TRACKER_EVAL" >/dev/null
+  scripts/experiments/eval_heldout.sh base,intra,track sim_intra_track "${MODEL_FLAGS[@]}" \
+    --tracker-config "$TRACKER_EVAL" >/dev/null
 for c in "${NAMES[@]}"; do
   [ -f "out/heldout/sim_$c/eval/metrics.json" ] ||
-    scripts/eval_heldout.sh base,intra,track,inter "sim_$c" "${MODEL_FLAGS[@]}" --inter-model "$OUT/$c.pt" \
-      --tracker-config "$TRACKER_EVAL" >/dev/null
+    scripts/experiments/eval_heldout.sh base,intra,track,inter "sim_$c" "${MODEL_FLAGS[@]}" \
+      --inter-model "$OUT/$c.pt" --tracker-config "$TRACKER_EVAL" >/dev/null
   [ -f "$OUT/$c.bench.json" ] ||
     ret3d bench --stages track,inter --models "$MODELS" --inter-model "$OUT/$c.pt" --tracker-config "$TRACKER_EVAL" \
       --objects 50 --json "$OUT/$c.bench.json" >"$OUT/$c.bench.log" 2>&1
 done
-python3 scripts/results_table.py inter "$OUT" "${NAMES[@]}"
+python3 scripts/experiments/results_table.py inter "$OUT" "${NAMES[@]}"
 # Table 3 analogue with the shipped history length (config/relation/inter_lwd3d.yaml), when its rows are all there
-# (base and + IntraRM come from scripts/ablate_intra_sim.sh).
+# (base and + IntraRM come from scripts/experiments/ablate_intra_sim.sh).
 shipped=$(sed -n 's/^ *max_history: *\([0-9]*\).*/\1/p' config/relation/inter_lwd3d.yaml)
 if [ -f out/heldout/base/eval/metrics.json ] && [ -f out/heldout/intra_lwd3d_m1/eval/metrics.json ] &&
   [ -f "out/heldout/sim_inter_h$shipped/eval/metrics.json" ]; then
-  python3 scripts/results_table.py table3 "inter_h$shipped"
+  python3 scripts/experiments/results_table.py table3 "inter_h$shipped"
 fi

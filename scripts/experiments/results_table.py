@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""Markdown tables of the simulated ablations (scripts/ablate_{intra,inter}_sim.sh) from their held-out evaluations
-(out/heldout/NAME/eval/metrics.json), printed and written into docs/RESULTS.md between the table's markers.
+"""Markdown tables of the simulated ablations (scripts/experiments/ablate_{intra,inter}_sim.sh) from their held-out
+evaluations (out/heldout/NAME/eval/metrics.json), printed and written into docs/RESULTS.md between the table's markers.
 
   results_table.py intra OUT_DIR CONFIG...   # rows: base, then base + each IntraRM
   results_table.py inter OUT_DIR NAME...     # rows: + IntraRM + tracker, then + each InterRM (history, encoding)

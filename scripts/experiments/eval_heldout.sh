@@ -2,12 +2,12 @@
 # Evaluates the pipeline on the held-out simulated set of the model card: urban, HDL-64E, 5 sequences x 100 frames,
 # seeds 9000-9004 (never used for training: those are 1000-1031 urban, 2000-2007 highway, 3000-3011 relation
 # modules, 5000-5001 validation), or HELDOUT_SEED's five sequences.
-#   scripts/eval_heldout.sh [STAGES] [NAME] [extra ret3d detect options...]
-#   scripts/eval_heldout.sh base base --models models/lwd3d
-#   scripts/eval_heldout.sh base,intra intra --models models/lwd3d
+#   scripts/experiments/eval_heldout.sh [STAGES] [NAME] [extra ret3d detect options...]
+#   scripts/experiments/eval_heldout.sh base base --models models/lwd3d
+#   scripts/experiments/eval_heldout.sh base,intra intra --models models/lwd3d
 # Writes out/heldout/NAME/{pred,eval,velocity.json,detect.log} and prints the headline figures.
 set -eo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 STAGES=${1:-base}
 NAME=${2:-$STAGES}
 shift 2 || true

@@ -3,7 +3,7 @@
 neighbours a detected box has within each radius (IntraRM links boxes whose BEV centres are closer than r), and how
 far the detected boxes are from the objects they found (centre error, heading error), per class.
 
-Usage: scripts/intra_graph_stats.py --gt DATA --pred PRED [--radii 1 2 4] [--min-score 0]
+Usage: scripts/experiments/intra_graph_stats.py --gt DATA --pred PRED [--radii 1 2 4] [--min-score 0]
 DATA is a KITTI tracking layout (training/label_02/SSSS.txt), PRED a `ret3d detect` output folder (SSSS.txt, the
 same format with a score). Boxes are compared in the bird's-eye view of the camera frame (x, z).
 """
