@@ -34,7 +34,7 @@ std::string fmt(double v, int digits = 1) {
   return b;
 }
 
-// `--stats DATASET --stats-out PREFIX`: realism statistics of any KITTI-layout data (scripts/sim_realism.sh).
+// `--stats DATASET --stats-out PREFIX`: realism statistics of any KITTI-layout data (scripts/experiments/sim_realism.sh).
 int runStats(const SimArgs& args) {
   // Sensor models live in config/sensors of the package: next to --config's config/sim when given, else under the
   // working directory (the package root).
