@@ -12,6 +12,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "ret3d/core/json_writer.h"
 #include "ret3d/core/log.h"
 
 extern char** environ;
@@ -247,22 +248,9 @@ std::string headlineTable(const EvalReport& r) {
 namespace {
 
 std::string metricsJson(const std::map<std::string, double>& m) {
-  std::ostringstream o;
-  o << "{\n";
-  std::size_t i = 0;
-  for (const auto& [k, v] : m) {
-    o << "  \"" << k << "\": ";
-    if (!std::isfinite(v)) {
-      o << "null";
-    } else if (v == std::floor(v) && std::abs(v) < 1e15) {
-      o << static_cast<long long>(v);
-    } else {
-      o << fmt(v, 4);
-    }
-    o << (++i < m.size() ? ",\n" : "\n");
-  }
-  o << "}\n";
-  return o.str();
+  JsonWriter json({/*decimals=*/4, /*whole_as_integer=*/true, /*top_level_lines=*/true});
+  for (const auto& [k, v] : m) json.field(k, v);
+  return json.str();
 }
 
 void kittiTable(std::ostringstream& md, const KittiResult& k, const std::vector<std::string>& pngs,

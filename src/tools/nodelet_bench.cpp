@@ -39,6 +39,8 @@
 
 #include "ret3d/DetectionArray.h"
 #include "ret3d/Object3DArray.h"
+#include "ret3d/core/json_writer.h"
+#include "ret3d/core/stats.h"
 #include "ret3d/ros/diagnostics.h"
 #include "ret3d/ros/params.h"
 
@@ -708,11 +710,16 @@ void reportSoak(const std::vector<SoakWindow>& windows, const NodeletBenchOption
   }
 
   if (o.json.empty()) return;
-  if (fs::path(o.json).has_parent_path()) fs::create_directories(fs::path(o.json).parent_path());
-  std::ostringstream json, table;
-  json << std::fixed << std::setprecision(3) << "{\"frames\": " << frames << ", \"every\": " << every
-       << ", \"rate_hz\": " << rate_hz << ", \"load\": " << o.load << ", \"warmup\": " << o.warmup
-       << ", \"measured\": " << measured << ", \"answered\": " << answered << ", \"samples\": [";
+  JsonWriter json({/*decimals=*/3});
+  json.field("frames", frames)
+      .field("every", every)
+      .field("rate_hz", rate_hz)
+      .field("load", o.load)
+      .field("warmup", o.warmup)
+      .field("measured", measured)
+      .field("answered", answered)
+      .beginArray("samples");
+  std::ostringstream table;
   table << "# frame\twall_s\trss_mb\tfds\tthreads\tcpu_cores\te2e_p50_ms\te2e_p95_ms\te2e_max_ms\tdetector_p50_ms\t"
            "detector_p95_ms\tanswered\tmeasured\tmachine_load\n"
         << std::fixed << std::setprecision(3);
@@ -720,16 +727,23 @@ void reportSoak(const std::vector<SoakWindow>& windows, const NodeletBenchOption
     const SoakWindow& w = windows[i];
     const double max = w.end_to_end_ms.empty() ? 0.0 : *std::max_element(w.end_to_end_ms.begin(), w.end_to_end_ms.end());
     const double t = w.process.wall_s - windows.front().process.wall_s;
-    json << (i ? ", " : "") << "{\"frame\": " << w.frame << ", \"wall_s\": " << t << ", \"rss_mb\": "
-         << w.process.rss_mb << ", \"fds\": " << w.process.fds << ", \"threads\": " << w.process.threads
-         << ", \"machine_load\": " << w.process.machine_load;
+    json.beginObject()
+        .field("frame", w.frame)
+        .field("wall_s", t)
+        .field("rss_mb", w.process.rss_mb)
+        .field("fds", w.process.fds)
+        .field("threads", w.process.threads)
+        .field("machine_load", w.process.machine_load);
     if (w.frame > 0)
-      json << ", \"cpu_cores\": " << w.cpu_cores << ", \"end_to_end_p50_ms\": " << percentile(w.end_to_end_ms, 50)
-           << ", \"end_to_end_p95_ms\": " << percentile(w.end_to_end_ms, 95) << ", \"end_to_end_max_ms\": " << max
-           << ", \"detector_p50_ms\": " << percentile(w.base_ms, 50)
-           << ", \"detector_p95_ms\": " << percentile(w.base_ms, 95) << ", \"answered\": " << w.answered
-           << ", \"measured\": " << w.measured;
-    json << "}";
+      json.field("cpu_cores", w.cpu_cores)
+          .field("end_to_end_p50_ms", percentile(w.end_to_end_ms, 50))
+          .field("end_to_end_p95_ms", percentile(w.end_to_end_ms, 95))
+          .field("end_to_end_max_ms", max)
+          .field("detector_p50_ms", percentile(w.base_ms, 50))
+          .field("detector_p95_ms", percentile(w.base_ms, 95))
+          .field("answered", w.answered)
+          .field("measured", w.measured);
+    json.endObject();
     if (w.frame > 0)
       table << w.frame << "\t" << t << "\t" << w.process.rss_mb << "\t" << w.process.fds << "\t" << w.process.threads
             << "\t" << w.cpu_cores << "\t" << percentile(w.end_to_end_ms, 50) << "\t"
@@ -737,17 +751,24 @@ void reportSoak(const std::vector<SoakWindow>& windows, const NodeletBenchOption
             << percentile(w.base_ms, 95) << "\t" << w.answered << "\t" << w.measured << "\t"
             << w.process.machine_load << "\n";
   }
-  json << "]";
+  json.endArray();
   if (checks)
-    json << ", \"checks\": {\"reference_frame\": " << k << ", \"rss_reference_mb\": " << ref->process.rss_mb
-         << ", \"rss_end_mb\": " << end.process.rss_mb << ", \"rss_growth_percent\": " << rss_growth
-         << ", \"fds_reference\": " << ref->process.fds << ", \"fds_end\": " << end.process.fds
-         << ", \"p95_first_ms\": " << p95_first << ", \"p95_last_ms\": " << p95_last
-         << ", \"p95_change_percent\": " << p95_change << ", \"rss_ok\": " << (rss_ok ? "true" : "false")
-         << ", \"fds_ok\": " << (fds_ok ? "true" : "false") << ", \"p95_ok\": " << (p95_ok ? "true" : "false")
-         << ", \"passed\": " << (rss_ok && fds_ok && p95_ok ? "true" : "false") << "}";
-  json << "}\n";
-  std::ofstream(o.json) << json.str();
+    json.beginObject("checks")
+        .field("reference_frame", k)
+        .field("rss_reference_mb", ref->process.rss_mb)
+        .field("rss_end_mb", end.process.rss_mb)
+        .field("rss_growth_percent", rss_growth)
+        .field("fds_reference", ref->process.fds)
+        .field("fds_end", end.process.fds)
+        .field("p95_first_ms", p95_first)
+        .field("p95_last_ms", p95_last)
+        .field("p95_change_percent", p95_change)
+        .field("rss_ok", rss_ok)
+        .field("fds_ok", fds_ok)
+        .field("p95_ok", p95_ok)
+        .field("passed", rss_ok && fds_ok && p95_ok)
+        .endObject();
+  json.save(o.json);
   const std::string tsv = fs::path(o.json).replace_extension(".tsv").string();
   std::ofstream(tsv) << table.str();
   std::cout << "bench: wrote " << o.json << " and " << tsv << "\n";
@@ -1019,25 +1040,30 @@ int runNodeletBench(const NodeletBenchOptions& o, NodeletBenchResult* result) {
                "say more about the host than about the pipeline)\n";
 
   if (!o.json.empty()) {
-    std::ostringstream json;
-    json << std::fixed << std::setprecision(3) << "{";
+    JsonWriter json({/*decimals=*/3});
     auto add = [&](const Row& r) {
-      json << "\"" << r.name << "\": {\"median_ms\": " << percentile(r.ms, 50) << ", \"p95_ms\": " << percentile(r.ms, 95)
-           << ", \"frames_out\": " << r.out;
+      json.beginObject(r.name)
+          .field("median_ms", percentile(r.ms, 50))
+          .field("p95_ms", percentile(r.ms, 95))
+          .field("frames_out", r.out);
       if (r.processing_p50 >= 0)
-        json << ", \"processing_median_ms\": " << r.processing_p50 << ", \"processing_p95_ms\": " << r.processing_p95;
-      json << "}, ";
+        json.field("processing_median_ms", r.processing_p50).field("processing_p95_ms", r.processing_p95);
+      json.endObject();
     };
     add(input);
     for (const Row& r : rows) add(r);
     add(end_to_end);
-    json << "\"frames\": " << frames << ", \"frames_out\": " << frames_out << ", \"dropped\": " << dropped
-         << ", \"warmup\": " << o.warmup << ", \"input_rate_hz\": " << plan.cloud_rate_hz * o.rate
-         << ", \"cpu_cores\": " << cpu.cores << ", \"cpu_percent\": " << 100.0 * cpu.cores / cores
-         << ", \"steal_percent\": " << cpu.steal_percent
-         << ", \"cores\": " << cores << ", \"threads\": " << o.threads << "}\n";
-    if (fs::path(o.json).has_parent_path()) fs::create_directories(fs::path(o.json).parent_path());
-    std::ofstream(o.json) << json.str();
+    json.field("frames", frames)
+        .field("frames_out", frames_out)
+        .field("dropped", dropped)
+        .field("warmup", o.warmup)
+        .field("input_rate_hz", plan.cloud_rate_hz * o.rate)
+        .field("cpu_cores", cpu.cores)
+        .field("cpu_percent", 100.0 * cpu.cores / cores)
+        .field("steal_percent", cpu.steal_percent)
+        .field("cores", cores)
+        .field("threads", o.threads);
+    json.save(o.json);
     std::cout << "bench: wrote " << o.json << "\n";
   }
   return 0;
