@@ -183,6 +183,18 @@ MotSimilarity parseSimilarity(const std::string& name) {
   throw std::invalid_argument("--mot-similarity: iou3d, bev or center");
 }
 
+// Not inlined: inlined into runEval, GCC 12 warns (falsely) that MotOptions' default class list may be uninitialized.
+[[gnu::noinline]] MotOptions motOptions(const EvalArgs& a, const std::vector<ObjectClass>& classes) {
+  MotOptions o;
+  o.classes = classes;
+  o.threads = a.threads;
+  o.threshold = a.mot_threshold;
+  o.zero_distance = a.mot_zero_distance;
+  o.max_range = a.mot_max_range;
+  o.similarity = parseSimilarity(a.mot_similarity);
+  return o;
+}
+
 // The metrics' results; EvalReport points into them.
 struct EvalResults {
   KittiResult kitti_strict, kitti_loose;
@@ -239,13 +251,7 @@ void evalMot(const EvalArgs& a, const std::vector<ObjectClass>& classes, const E
     report->notes.push_back("Tracking metrics skipped: " + why + ".");
     return;
   }
-  MotOptions o;
-  o.classes = classes;
-  o.threads = a.threads;
-  o.threshold = a.mot_threshold;
-  o.zero_distance = a.mot_zero_distance;
-  o.max_range = a.mot_max_range;
-  o.similarity = parseSimilarity(a.mot_similarity);
+  const MotOptions o = motOptions(a, classes);
   res->mot = evaluateMot(data.frames, o);
   report->mot = &res->mot;
   report->mot_options = o;
