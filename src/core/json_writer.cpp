@@ -50,7 +50,8 @@ void JsonWriter::element() {
 }
 
 void JsonWriter::member(const std::string& key) {
-  if (levels_.empty() || levels_.back().array) throw std::logic_error("JsonWriter: member \"" + key + "\" outside an object");
+  if (levels_.empty() || levels_.back().array)
+    throw std::logic_error("JsonWriter: member \"" + key + "\" outside an object");
   element();
   out_ << quoted(key) << ": ";
 }
@@ -63,7 +64,8 @@ JsonWriter& JsonWriter::beginObject(const std::string& key) {
 }
 
 JsonWriter& JsonWriter::beginObject() {
-  if (levels_.empty() || !levels_.back().array) throw std::logic_error("JsonWriter: object without a key outside an array");
+  if (levels_.empty() || !levels_.back().array)
+    throw std::logic_error("JsonWriter: object without a key outside an array");
   element();
   out_ << "{";
   levels_.push_back({});

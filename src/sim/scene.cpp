@@ -650,7 +650,7 @@ class StaticGeometryBuilder {
     }
   }
 
-  // Hedges along the sidewalk's outer edge, bushes beyond it, bollards at the curb (their own stream).
+  // Hedges along the sidewalk's outer edge; hedges, bushes and bollards draw from their own stream (`extra`).
   void hedges(const Road& road, int side, Rng& extra) {
     const double L = road.center.length();
     const double W = road.half_width, SW = road.sidewalk;
@@ -679,6 +679,7 @@ class StaticGeometryBuilder {
     }
   }
 
+  // Bushes beyond the sidewalk.
   void bushes(const Road& road, int side, Rng& extra) {
     const double L = road.center.length();
     const double W = road.half_width, SW = road.sidewalk;
@@ -699,6 +700,7 @@ class StaticGeometryBuilder {
     }
   }
 
+  // Bollards at the curb, none near a zebra crossing.
   void bollards(const Road& road, std::size_t r, int side, Rng& extra) {
     const double L = road.center.length();
     const double W = road.half_width;

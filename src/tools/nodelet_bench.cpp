@@ -937,7 +937,8 @@ void tabulate(const Recorder& recorder, const DiagnosticsRecorder& diagnostics, 
   const auto measured = recorder.measured();
   m->frames = measured.size();
   for (std::size_t k = 0; k < stages.size(); ++k) {
-    m->rows.emplace_back(stages[k].name, "  " + stages[k].input + " to " + stages[k].output + " (" + stages[k].type + ")");
+    m->rows.emplace_back(stages[k].name,
+                         "  " + stages[k].input + " to " + stages[k].output + " (" + stages[k].type + ")");
     m->rows.back().processing_p50 = diagnostics.value(stages[k].nodelet, "processing p50 (ms)");
     m->rows.back().processing_p95 = diagnostics.value(stages[k].nodelet, "processing p95 (ms)");
   }
