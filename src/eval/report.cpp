@@ -12,6 +12,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "ret3d/core/json_writer.h"
 #include "ret3d/core/log.h"
 
 extern char** environ;
@@ -247,22 +248,9 @@ std::string headlineTable(const EvalReport& r) {
 namespace {
 
 std::string metricsJson(const std::map<std::string, double>& m) {
-  std::ostringstream o;
-  o << "{\n";
-  std::size_t i = 0;
-  for (const auto& [k, v] : m) {
-    o << "  \"" << k << "\": ";
-    if (!std::isfinite(v)) {
-      o << "null";
-    } else if (v == std::floor(v) && std::abs(v) < 1e15) {
-      o << static_cast<long long>(v);
-    } else {
-      o << fmt(v, 4);
-    }
-    o << (++i < m.size() ? ",\n" : "\n");
-  }
-  o << "}\n";
-  return o.str();
+  JsonWriter json({/*decimals=*/4, /*whole_as_integer=*/true, /*top_level_lines=*/true});
+  for (const auto& [k, v] : m) json.field(k, v);
+  return json.str();
 }
 
 void kittiTable(std::ostringstream& md, const KittiResult& k, const std::vector<std::string>& pngs,
@@ -287,80 +275,83 @@ void kittiTable(std::ostringstream& md, const KittiResult& k, const std::vector<
   }
 }
 
-}  // namespace
-
-std::vector<std::string> writeReport(const std::string& dir, const EvalReport& r) {
-  fs::create_directories(dir);
-  const std::string plots = pathJoin(dir, "plots");
-  fs::create_directories(plots);
-  const auto metrics = metricsMap(r);
-  writeFile(pathJoin(dir, "metrics.json"), metricsJson(metrics));
-
-  // ---- plots ----
-  std::vector<std::string> pngs;
-  bool gnuplot_ok = true;
-  const auto draw = [&](const std::string& name, const std::string& title, const std::string& ylabel,
-                        const std::vector<Series>& series) {
-    if (!gnuplot_ok) return;
-    if (plot(plots, name, title, ylabel, series)) {
-      pngs.push_back(name + ".png");
+// Draws the plots with gnuplot into one folder; after the first failure (gnuplot missing) it stops trying.
+class Plots {
+ public:
+  explicit Plots(std::string dir) : dir_(std::move(dir)) {}
+  const std::string& dir() const { return dir_; }
+  const std::vector<std::string>& pngs() const { return pngs_; }
+  void draw(const std::string& name, const std::string& title, const std::string& ylabel,
+            const std::vector<Series>& series) {
+    if (!gnuplot_ok_) return;
+    if (plot(dir_, name, title, ylabel, series)) {
+      pngs_.push_back(name + ".png");
     } else {
-      gnuplot_ok = false;
+      gnuplot_ok_ = false;
       RET3D_WARN("gnuplot failed or is missing: no plots (metrics.json and report.md are complete)");
     }
-  };
-  if (r.kitti) {
-    for (const auto& c : r.kitti->classes) {
-      for (int mi = 0; mi < 4; ++mi) {
-        if (mi == 3 && !r.kitti->aos_valid) continue;
-        const std::string name = std::string("kitti_") + className(c.cls) + "_" + safeName(kittiMetricTitle(mi));
-        std::ostringstream data;
-        data << "# recall easy moderate hard (devkit's 41 samples, interpolated)\n";
-        for (int i = 0; i < kKittiSamplePoints; ++i) {
-          data << fmt(i / 40.0, 3);
-          for (int d = 0; d < 3; ++d) data << " " << fmt(kittiCurve(c, mi, d).precision[i], 6);
-          data << "\n";
-        }
-        writeFile(pathJoin(plots, name + ".txt"), data.str());
-        std::vector<Series> s;
-        for (int d = 0; d < 3; ++d) {
-          const auto& cv = kittiCurve(c, mi, d);
-          const std::string label = std::string(d == 0 ? "Easy" : d == 1 ? "Moderate" : "Hard") + " (R40 " +
-                                    fmt(cv.ap40()) + ", R11 " + fmt(cv.ap11()) + ", " + std::to_string(cv.num_gt) +
-                                    " GT)";
-          s.push_back({name + ".txt", "1:" + std::to_string(d + 2), label});
-        }
-        const std::string title = std::string("KITTI ") + className(c.cls) + " " + kittiMetricTitle(mi) +
-                                  (mi == 3 ? " (2D match" : " (IoU") + " >= " + fmt(c.min_overlap) + ")";
-        draw(name, title, mi == 3 ? "Orientation similarity" : "Precision", s);
-      }
-    }
-  }
-  if (r.waymo) {
-    for (const auto& c : r.waymo->classes) {
-      const std::string name = std::string("waymo_") + className(c.cls);
-      std::vector<Series> s;
-      for (int l = 0; l < kWaymoNumLevels; ++l) {
-        const auto& cv = c.levels[l];
-        const std::string data_name = name + "_" + levelKey(static_cast<WaymoLevel>(l)) + ".txt";
-        std::ostringstream data;
-        data << "# recall precision recall_h precision_h (one row per score cutoff)\n0 1 0 1\n";
-        for (std::size_t i = 0; i < cv.recall.size(); ++i) {
-          data << fmt(cv.recall[i], 6) << " " << fmt(cv.precision[i], 6) << " " << fmt(cv.recall_h[i], 6) << " "
-               << fmt(cv.precision_h[i], 6) << "\n";
-        }
-        writeFile(pathJoin(plots, data_name), data.str());
-        const std::string lv = levelKey(static_cast<WaymoLevel>(l));
-        s.push_back({data_name, "1:2", lv + " AP " + fmt(cv.ap) + " (" + std::to_string(cv.num_gt) + " GT)"});
-        s.push_back({data_name, "3:4", lv + " APH " + fmt(cv.aph)});
-      }
-      draw(name, std::string("Waymo-style ") + className(c.cls) + " (3D IoU >= " + fmt(c.iou_threshold) + ")",
-           "Precision", s);
-    }
   }
 
-  // ---- report.md ----
-  std::ostringstream md;
+ private:
+  std::string dir_;
+  std::vector<std::string> pngs_;
+  bool gnuplot_ok_ = true;
+};
+
+// Precision-recall curves per class, metric and difficulty (data beside each plot).
+void plotKitti(const EvalReport& r, Plots* plots) {
+  for (const auto& c : r.kitti->classes) {
+    for (int mi = 0; mi < 4; ++mi) {
+      if (mi == 3 && !r.kitti->aos_valid) continue;
+      const std::string name = std::string("kitti_") + className(c.cls) + "_" + safeName(kittiMetricTitle(mi));
+      std::ostringstream data;
+      data << "# recall easy moderate hard (devkit's 41 samples, interpolated)\n";
+      for (int i = 0; i < kKittiSamplePoints; ++i) {
+        data << fmt(i / 40.0, 3);
+        for (int d = 0; d < 3; ++d) data << " " << fmt(kittiCurve(c, mi, d).precision[i], 6);
+        data << "\n";
+      }
+      writeFile(pathJoin(plots->dir(), name + ".txt"), data.str());
+      std::vector<Series> s;
+      for (int d = 0; d < 3; ++d) {
+        const auto& cv = kittiCurve(c, mi, d);
+        const std::string label = std::string(d == 0 ? "Easy" : d == 1 ? "Moderate" : "Hard") + " (R40 " +
+                                  fmt(cv.ap40()) + ", R11 " + fmt(cv.ap11()) + ", " + std::to_string(cv.num_gt) +
+                                  " GT)";
+        s.push_back({name + ".txt", "1:" + std::to_string(d + 2), label});
+      }
+      const std::string title = std::string("KITTI ") + className(c.cls) + " " + kittiMetricTitle(mi) +
+                                (mi == 3 ? " (2D match" : " (IoU") + " >= " + fmt(c.min_overlap) + ")";
+      plots->draw(name, title, mi == 3 ? "Orientation similarity" : "Precision", s);
+    }
+  }
+}
+
+// Precision-recall and heading-weighted curves per class and level.
+void plotWaymo(const EvalReport& r, Plots* plots) {
+  for (const auto& c : r.waymo->classes) {
+    const std::string name = std::string("waymo_") + className(c.cls);
+    std::vector<Series> s;
+    for (int l = 0; l < kWaymoNumLevels; ++l) {
+      const auto& cv = c.levels[l];
+      const std::string data_name = name + "_" + levelKey(static_cast<WaymoLevel>(l)) + ".txt";
+      std::ostringstream data;
+      data << "# recall precision recall_h precision_h (one row per score cutoff)\n0 1 0 1\n";
+      for (std::size_t i = 0; i < cv.recall.size(); ++i) {
+        data << fmt(cv.recall[i], 6) << " " << fmt(cv.precision[i], 6) << " " << fmt(cv.recall_h[i], 6) << " "
+             << fmt(cv.precision_h[i], 6) << "\n";
+      }
+      writeFile(pathJoin(plots->dir(), data_name), data.str());
+      const std::string lv = levelKey(static_cast<WaymoLevel>(l));
+      s.push_back({data_name, "1:2", lv + " AP " + fmt(cv.ap) + " (" + std::to_string(cv.num_gt) + " GT)"});
+      s.push_back({data_name, "3:4", lv + " APH " + fmt(cv.aph)});
+    }
+    plots->draw(name, std::string("Waymo-style ") + className(c.cls) + " (3D IoU >= " + fmt(c.iou_threshold) + ")",
+         "Precision", s);
+  }
+}
+
+void reportInputs(std::ostringstream& md, const EvalReport& r) {
   md << "# ret3d evaluation report\n\n## Inputs\n\n"
      << "| | |\n| --- | --- |\n"
      << "| ground truth | " << r.gt_source << " |\n"
@@ -374,132 +365,156 @@ std::vector<std::string> writeReport(const std::string& dir, const EvalReport& r
     for (const auto& n : r.notes) md << "- " << n << "\n";
     md << "\n";
   }
-  if (r.kitti) {
-    md << "## KITTI object detection AP (official devkit rules)\n\n"
-       << "Computed as the KITTI object devkit (evaluate_object_3d_offline, with the 2017 minimum-height fix) in "
-          "camera coordinates. Difficulty: easy = 2D box height >= 40 px, occlusion 0, truncation <= 0.15; moderate "
-          "= >= 25 px, occlusion <= 1, truncation <= 0.3; hard = >= 25 px, occlusion <= 2, truncation <= 0.5. "
-          "Van is ignored for Car and Person_sitting for Pedestrian; detections in DontCare regions are not false "
-          "positives; detections below the minimum height are ignored. R11 = the devkit's printed 11-point AP "
-          "(mean precision at its sample points 0, 4, ..., 40 of 41); R40 = mean precision at recall 1/40 .. 40/40. AOS uses the 2D "
-          "matching. Values in percent.\n\n"
-       << (r.kitti->exact_recall
-               ? "**Exact recall sampling** (`--kitti-recall exact`): the precision at recall k/40 is the best precision "
-                 "at an actual recall of at least k/40, every true positive's score a threshold. The devkit's own "
-                 "sampling takes its k-th threshold as recall k/40, which holds only with 40 or more valid ground "
-                 "truths per class and difficulty: with fewer, matching every object still scores (TP - 1) / 40.\n\n"
-               : "")
-       << "Ground truth counted (valid at each difficulty) and detections:\n\n"
-       << "| class | easy | moderate | hard | detections |\n| --- | ---: | ---: | ---: | ---: |\n";
-    for (const auto& c : r.kitti->classes) {
-      md << "| " << className(c.cls) << " | " << c.curves[2][0].num_gt << " | " << c.curves[2][1].num_gt << " | "
-         << c.curves[2][2].num_gt << " | " << c.num_det << " |\n";
-    }
-    {
-      const KittiFalseBoxes& fb = r.kitti->false_boxes;
-      const double nf = static_cast<double>(std::max<std::size_t>(1, r.kitti->num_frames));
-      md << "\nFalse boxes (detections with BEV IoU < 0.1 against every label of any type and not in a DontCare "
-            "region), per frame: **"
-         << fmt(fb.total() / nf) << "** (Car " << fmt(fb.per_class[0] / nf) << ", Pedestrian "
-         << fmt(fb.per_class[1] / nf) << ", Cyclist " << fmt(fb.per_class[2] / nf) << "); with score >= 0.5: "
-         << fmt(fb.totalScore50() / nf) << ".\n";
-    }
-    md << "\n### Strict IoU thresholds (Car 0.7, Pedestrian 0.5, Cyclist 0.5)\n\n";
-    kittiTable(md, *r.kitti, pngs, "kitti_");
-    if (r.kitti_loose) {
-      md << "### Loose IoU thresholds (Car 0.5, Pedestrian 0.25, Cyclist 0.25; keys kitti_loose.*)\n\n";
-      kittiTable(md, *r.kitti_loose, pngs, "");
-    }
+}
+
+void reportKitti(std::ostringstream& md, const EvalReport& r, const std::vector<std::string>& pngs) {
+  md << "## KITTI object detection AP (official devkit rules)\n\n"
+     << "Computed as the KITTI object devkit (evaluate_object_3d_offline, with the 2017 minimum-height fix) in "
+        "camera coordinates. Difficulty: easy = 2D box height >= 40 px, occlusion 0, truncation <= 0.15; moderate "
+        "= >= 25 px, occlusion <= 1, truncation <= 0.3; hard = >= 25 px, occlusion <= 2, truncation <= 0.5. "
+        "Van is ignored for Car and Person_sitting for Pedestrian; detections in DontCare regions are not false "
+        "positives; detections below the minimum height are ignored. R11 = the devkit's printed 11-point AP "
+        "(mean precision at its sample points 0, 4, ..., 40 of 41); R40 = mean precision at recall 1/40 .. 40/40. AOS uses the 2D "
+        "matching. Values in percent.\n\n"
+     << (r.kitti->exact_recall
+             ? "**Exact recall sampling** (`--kitti-recall exact`): the precision at recall k/40 is the best precision "
+               "at an actual recall of at least k/40, every true positive's score a threshold. The devkit's own "
+               "sampling takes its k-th threshold as recall k/40, which holds only with 40 or more valid ground "
+               "truths per class and difficulty: with fewer, matching every object still scores (TP - 1) / 40.\n\n"
+             : "")
+     << "Ground truth counted (valid at each difficulty) and detections:\n\n"
+     << "| class | easy | moderate | hard | detections |\n| --- | ---: | ---: | ---: | ---: |\n";
+  for (const auto& c : r.kitti->classes) {
+    md << "| " << className(c.cls) << " | " << c.curves[2][0].num_gt << " | " << c.curves[2][1].num_gt << " | "
+       << c.curves[2][2].num_gt << " | " << c.num_det << " |\n";
   }
-  if (r.waymo) {
-    const auto& o = r.waymo_options;
-    md << "## Waymo-style AP / APH (LiDAR frame, 360 degrees)\n\n"
-       << "3D IoU thresholds: Car " << fmt(o.iou_threshold[0]) << ", Pedestrian " << fmt(o.iou_threshold[1])
-       << ", Cyclist " << fmt(o.iou_threshold[2]) << ". Heading accuracy of a match: 1 - |dyaw| / pi (wrapped). ";
-    if (r.waymo->used_point_counts) {
-      md << "Levels from the LiDAR points in each ground-truth box: 0 points -> dropped (" << r.waymo->dropped_empty_gt
-         << " boxes), 1.." << o.level2_max_points << " -> LEVEL_2, more -> LEVEL_1; L1 ignores LEVEL_2 boxes, L2 "
-         << "evaluates both. ";
-    } else {
-      md << "No point counts were available (no counts in the ground truth, no scans): every box is LEVEL_1, so L1 "
-            "and L2 agree. ";
-    }
-    md << "Matching: predictions in descending score order take the unmatched ground truth of highest IoU; AP = area "
-          "under the max-precision-interpolated precision-recall curve (every score cutoff); APH the same on "
-          "heading-weighted precision and recall. Van / Person_sitting are ignore regions.\n\n"
-       << "| class | L1 AP | L1 APH | L2 AP | L2 APH | L1 GT | L2 GT | TP (L2) | FP (L2) |\n"
-       << "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
-    for (const auto& c : r.waymo->classes) {
-      md << "| " << className(c.cls) << " | " << fmt(c.levels[0].ap) << " | " << fmt(c.levels[0].aph) << " | "
-         << fmt(c.levels[1].ap) << " | " << fmt(c.levels[1].aph) << " | " << c.levels[0].num_gt << " | "
-         << c.levels[1].num_gt << " | " << c.levels[1].num_tp << " | " << c.levels[1].num_fp << " |\n";
-    }
-    md << "| mean | " << fmt(r.waymo->mean_ap[0]) << " | " << fmt(r.waymo->mean_aph[0]) << " | "
-       << fmt(r.waymo->mean_ap[1]) << " | " << fmt(r.waymo->mean_aph[1]) << " | | | | |\n\n";
-    md << "By range (horizontal distance from the sensor; ground truth outside the bin is ignored, predictions "
-          "outside it dropped), L2 AP / APH:\n\n| class |";
-    for (const auto& b : o.ranges) md << " " << b.name << " m |";
-    md << "\n| --- |";
-    for (std::size_t k = 0; k < o.ranges.size(); ++k) md << " ---: |";
-    md << "\n";
-    for (const auto& c : r.waymo->classes) {
-      md << "| " << className(c.cls) << " |";
-      for (const auto& rb : c.ranges) {
-        md << " " << fmt(rb[1].ap) << " / " << fmt(rb[1].aph) << " (" << rb[1].num_gt << " GT) |";
-      }
-      md << "\n";
-    }
-    md << "\n";
-    for (const auto& png : pngs) {
-      if (png.rfind("waymo_", 0) == 0) md << "![" << png << "](plots/" << png << ")\n";
+  {
+    const KittiFalseBoxes& fb = r.kitti->false_boxes;
+    const double nf = static_cast<double>(std::max<std::size_t>(1, r.kitti->num_frames));
+    md << "\nFalse boxes (detections with BEV IoU < 0.1 against every label of any type and not in a DontCare "
+          "region), per frame: **"
+       << fmt(fb.total() / nf) << "** (Car " << fmt(fb.per_class[0] / nf) << ", Pedestrian "
+       << fmt(fb.per_class[1] / nf) << ", Cyclist " << fmt(fb.per_class[2] / nf) << "); with score >= 0.5: "
+       << fmt(fb.totalScore50() / nf) << ".\n";
+  }
+  md << "\n### Strict IoU thresholds (Car 0.7, Pedestrian 0.5, Cyclist 0.5)\n\n";
+  kittiTable(md, *r.kitti, pngs, "kitti_");
+  if (r.kitti_loose) {
+    md << "### Loose IoU thresholds (Car 0.5, Pedestrian 0.25, Cyclist 0.25; keys kitti_loose.*)\n\n";
+    kittiTable(md, *r.kitti_loose, pngs, "");
+  }
+}
+
+void reportWaymo(std::ostringstream& md, const EvalReport& r, const std::vector<std::string>& pngs) {
+  const auto& o = r.waymo_options;
+  md << "## Waymo-style AP / APH (LiDAR frame, 360 degrees)\n\n"
+     << "3D IoU thresholds: Car " << fmt(o.iou_threshold[0]) << ", Pedestrian " << fmt(o.iou_threshold[1])
+     << ", Cyclist " << fmt(o.iou_threshold[2]) << ". Heading accuracy of a match: 1 - |dyaw| / pi (wrapped). ";
+  if (r.waymo->used_point_counts) {
+    md << "Levels from the LiDAR points in each ground-truth box: 0 points -> dropped (" << r.waymo->dropped_empty_gt
+       << " boxes), 1.." << o.level2_max_points << " -> LEVEL_2, more -> LEVEL_1; L1 ignores LEVEL_2 boxes, L2 "
+       << "evaluates both. ";
+  } else {
+    md << "No point counts were available (no counts in the ground truth, no scans): every box is LEVEL_1, so L1 "
+          "and L2 agree. ";
+  }
+  md << "Matching: predictions in descending score order take the unmatched ground truth of highest IoU; AP = area "
+        "under the max-precision-interpolated precision-recall curve (every score cutoff); APH the same on "
+        "heading-weighted precision and recall. Van / Person_sitting are ignore regions.\n\n"
+     << "| class | L1 AP | L1 APH | L2 AP | L2 APH | L1 GT | L2 GT | TP (L2) | FP (L2) |\n"
+     << "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+  for (const auto& c : r.waymo->classes) {
+    md << "| " << className(c.cls) << " | " << fmt(c.levels[0].ap) << " | " << fmt(c.levels[0].aph) << " | "
+       << fmt(c.levels[1].ap) << " | " << fmt(c.levels[1].aph) << " | " << c.levels[0].num_gt << " | "
+       << c.levels[1].num_gt << " | " << c.levels[1].num_tp << " | " << c.levels[1].num_fp << " |\n";
+  }
+  md << "| mean | " << fmt(r.waymo->mean_ap[0]) << " | " << fmt(r.waymo->mean_aph[0]) << " | "
+     << fmt(r.waymo->mean_ap[1]) << " | " << fmt(r.waymo->mean_aph[1]) << " | | | | |\n\n";
+  md << "By range (horizontal distance from the sensor; ground truth outside the bin is ignored, predictions "
+        "outside it dropped), L2 AP / APH:\n\n| class |";
+  for (const auto& b : o.ranges) md << " " << b.name << " m |";
+  md << "\n| --- |";
+  for (std::size_t k = 0; k < o.ranges.size(); ++k) md << " ---: |";
+  md << "\n";
+  for (const auto& c : r.waymo->classes) {
+    md << "| " << className(c.cls) << " |";
+    for (const auto& rb : c.ranges) {
+      md << " " << fmt(rb[1].ap) << " / " << fmt(rb[1].aph) << " (" << rb[1].num_gt << " GT) |";
     }
     md << "\n";
   }
-  if (r.mot) {
-    const auto& o = r.mot_options;
-    md << "## Tracking (CLEAR MOT and HOTA, per class)\n\n"
-       << "Similarity: " << similarityName(o.similarity);
-    if (o.similarity == MotSimilarity::CenterDistance) md << " (1 - d / " << fmt(o.zero_distance) << " m)";
-    md << "; CLEAR matches need similarity >= " << fmt(o.threshold) << "; HOTA averages over alpha 0.05..0.95. ";
-    if (o.max_range > 0)
-      md << "Only boxes within " << fmt(o.max_range) << " m of the sensor (BEV) are evaluated, ground truth and "
-         << "predictions alike. ";
-    md << "MOTA, MOTP, HOTA, DetA, AssA in percent; IDSW and FRAG are counts; MT / ML in percent of ground-truth "
-          "tracks (tracked > 80 % / < 20 % of their frames). Definitions as TrackEval. "
-       << r.mot->num_sequences << " sequences; " << r.mot->removed_on_ignore
-       << " predictions on ignored ground truth (Van, Person_sitting) removed.\n\n"
-       << "| class | MOTA | MOTP | IDSW | FRAG | MT | ML | HOTA | DetA | AssA | GT | TP | FP | FN | GT tracks | "
-          "pred tracks |\n| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | "
-          "---: | ---: | ---: | ---: |\n";
-    for (const auto& c : r.mot->classes) {
-      const double tracks = std::max(1, c.clear.num_gt_tracks);
-      md << "| " << className(c.cls) << " | " << fmt(c.clear.mota) << " | " << fmt(c.clear.motp) << " | "
-         << c.clear.idsw << " | " << c.clear.frag << " | " << fmt(100.0 * c.clear.mt / tracks) << " | "
-         << fmt(100.0 * c.clear.ml / tracks) << " | " << fmt(c.hota.hota) << " | " << fmt(c.hota.deta) << " | "
-         << fmt(c.hota.assa) << " | " << c.clear.num_gt << " | " << c.clear.tp << " | " << c.clear.fp << " | "
-         << c.clear.fn << " | " << c.clear.num_gt_tracks << " | " << c.num_pred_tracks << " |\n";
-    }
-    md << "\n";
+  md << "\n";
+  for (const auto& png : pngs) {
+    if (png.rfind("waymo_", 0) == 0) md << "![" << png << "](plots/" << png << ")\n";
   }
-  if (r.id_stability) {
-    md << "## Track-id stability\n\n"
-       << "Of the ground-truth track-frames an output object covers (per frame and class, Hungarian on centre "
-          "distance < "
-       << fmt(r.id_stability_options.max_center_distance)
-       << " m), the share whose output id is the one that ground-truth track was covered by most often (stability); "
-          "coverage = covered / all ground-truth track-frames. Percent.\n\n"
-       << "| class | stability | coverage | GT track-frames | covered | stable | GT tracks covered | output ids |\n"
-          "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
-    auto row = [&md](const std::string& name, const IdStabilityCounts& c) {
-      md << "| " << name << " | " << fmt(c.stability()) << " | " << fmt(c.coverage()) << " | " << c.gt_track_frames
-         << " | " << c.matched << " | " << c.stable << " | " << c.gt_tracks << " | " << c.output_ids << " |\n";
-    };
-    for (const auto& c : r.id_stability->classes) row(className(c.cls), c.counts);
-    row("all", r.id_stability->all);
-    md << "\n";
+  md << "\n";
+}
+
+void reportMot(std::ostringstream& md, const EvalReport& r) {
+  const auto& o = r.mot_options;
+  md << "## Tracking (CLEAR MOT and HOTA, per class)\n\n"
+     << "Similarity: " << similarityName(o.similarity);
+  if (o.similarity == MotSimilarity::CenterDistance) md << " (1 - d / " << fmt(o.zero_distance) << " m)";
+  md << "; CLEAR matches need similarity >= " << fmt(o.threshold) << "; HOTA averages over alpha 0.05..0.95. ";
+  if (o.max_range > 0)
+    md << "Only boxes within " << fmt(o.max_range) << " m of the sensor (BEV) are evaluated, ground truth and "
+       << "predictions alike. ";
+  md << "MOTA, MOTP, HOTA, DetA, AssA in percent; IDSW and FRAG are counts; MT / ML in percent of ground-truth "
+        "tracks (tracked > 80 % / < 20 % of their frames). Definitions as TrackEval. "
+     << r.mot->num_sequences << " sequences; " << r.mot->removed_on_ignore
+     << " predictions on ignored ground truth (Van, Person_sitting) removed.\n\n"
+     << "| class | MOTA | MOTP | IDSW | FRAG | MT | ML | HOTA | DetA | AssA | GT | TP | FP | FN | GT tracks | "
+        "pred tracks |\n| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | "
+        "---: | ---: | ---: | ---: |\n";
+  for (const auto& c : r.mot->classes) {
+    const double tracks = std::max(1, c.clear.num_gt_tracks);
+    md << "| " << className(c.cls) << " | " << fmt(c.clear.mota) << " | " << fmt(c.clear.motp) << " | "
+       << c.clear.idsw << " | " << c.clear.frag << " | " << fmt(100.0 * c.clear.mt / tracks) << " | "
+       << fmt(100.0 * c.clear.ml / tracks) << " | " << fmt(c.hota.hota) << " | " << fmt(c.hota.deta) << " | "
+       << fmt(c.hota.assa) << " | " << c.clear.num_gt << " | " << c.clear.tp << " | " << c.clear.fp << " | "
+       << c.clear.fn << " | " << c.clear.num_gt_tracks << " | " << c.num_pred_tracks << " |\n";
   }
+  md << "\n";
+}
+
+void reportIdStability(std::ostringstream& md, const EvalReport& r) {
+  md << "## Track-id stability\n\n"
+     << "Of the ground-truth track-frames an output object covers (per frame and class, Hungarian on centre "
+        "distance < "
+     << fmt(r.id_stability_options.max_center_distance)
+     << " m), the share whose output id is the one that ground-truth track was covered by most often (stability); "
+        "coverage = covered / all ground-truth track-frames. Percent.\n\n"
+     << "| class | stability | coverage | GT track-frames | covered | stable | GT tracks covered | output ids |\n"
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+  auto row = [&md](const std::string& name, const IdStabilityCounts& c) {
+    md << "| " << name << " | " << fmt(c.stability()) << " | " << fmt(c.coverage()) << " | " << c.gt_track_frames
+       << " | " << c.matched << " | " << c.stable << " | " << c.gt_tracks << " | " << c.output_ids << " |\n";
+  };
+  for (const auto& c : r.id_stability->classes) row(className(c.cls), c.counts);
+  row("all", r.id_stability->all);
+  md << "\n";
+}
+
+}  // namespace
+
+std::vector<std::string> writeReport(const std::string& dir, const EvalReport& r) {
+  fs::create_directories(dir);
+  Plots plots(pathJoin(dir, "plots"));
+  fs::create_directories(plots.dir());
+  const auto metrics = metricsMap(r);
+  writeFile(pathJoin(dir, "metrics.json"), metricsJson(metrics));
+
+  if (r.kitti) plotKitti(r, &plots);
+  if (r.waymo) plotWaymo(r, &plots);
+
+  std::ostringstream md;
+  reportInputs(md, r);
+  if (r.kitti) reportKitti(md, r, plots.pngs());
+  if (r.waymo) reportWaymo(md, r, plots.pngs());
+  if (r.mot) reportMot(md, r);
+  if (r.id_stability) reportIdStability(md, r);
   writeFile(pathJoin(dir, "report.md"), md.str());
-  return pngs;
+  return plots.pngs();
 }
 
 }  // namespace eval

@@ -4,21 +4,10 @@
 #include <cmath>
 #include <numeric>
 
+#include "ret3d/core/stats.h"
+
 namespace ret3d {
 namespace eval {
-
-namespace {
-
-double quantile(std::vector<double> v, double q) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  const double pos = q * static_cast<double>(v.size() - 1);
-  const std::size_t lo = static_cast<std::size_t>(std::floor(pos));
-  const std::size_t hi = std::min(v.size() - 1, lo + 1);
-  return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
-}
-
-}  // namespace
 
 std::map<ObjectClass, VelocityErrorStats> velocityErrors(const std::vector<VelocityFrame>& frames, double moving_speed,
                                                          double match_distance) {
@@ -47,13 +36,13 @@ std::map<ObjectClass, VelocityErrorStats> velocityErrors(const std::vector<Veloc
   for (const auto& [c, v] : moving) {
     VelocityErrorStats& s = out[c];
     s.moving_matched = v.size();
-    s.moving_median = quantile(v, 0.5);
-    s.moving_p90 = quantile(v, 0.9);
+    s.moving_median = percentile(v, 50);
+    s.moving_p90 = percentile(v, 90);
   }
   for (const auto& [c, v] : still) {
     VelocityErrorStats& s = out[c];
     s.static_matched = v.size();
-    s.static_median = quantile(v, 0.5);
+    s.static_median = percentile(v, 50);
   }
   return out;
 }

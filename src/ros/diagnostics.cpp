@@ -6,16 +6,9 @@
 #include <diagnostic_msgs/DiagnosticStatus.h>
 #include <ros/ros.h>
 
-namespace ret3d {
+#include "ret3d/core/stats.h"
 
-double percentile(std::vector<double> values, double p) {
-  if (values.empty()) return 0.0;
-  std::sort(values.begin(), values.end());
-  const double pos = std::clamp(p, 0.0, 100.0) / 100.0 * static_cast<double>(values.size() - 1);
-  const std::size_t lo = static_cast<std::size_t>(std::floor(pos));
-  const std::size_t hi = std::min(lo + 1, values.size() - 1);
-  return values[lo] + (pos - static_cast<double>(lo)) * (values[hi] - values[lo]);
-}
+namespace ret3d {
 
 const char* dropReasonName(DropReason reason) {
   switch (reason) {

@@ -439,10 +439,38 @@ void Traffic::setReplay(std::vector<Actor> replayed, std::vector<Eigen::Isometry
   }
 }
 
+namespace {
+
+// Coarse: distance to the route's samples.
+bool nearRoute(const Path& route, const V2& p, double r) {
+  for (const auto& q : route.points())
+    if ((q - p).squaredNorm() < r * r) return true;
+  return false;
+}
+
+}  // namespace
+
 void Traffic::spawn(Rng& rng, double view_range) {
-  const TrafficConfig& tc = config_.traffic;
+  spawnEgo(rng);
   const Road& main = scene_.roads[0];
-  // The ego: a mid-size car in a lane of the main road's forward direction.
+  const Path route = main.center.slice(std::max(0.0, scene_.ego_start - 5), scene_.ego_start + scene_.ego_reach + 5, 4.0);
+  for (const Lane& l : scene_.lanes) {
+    if (l.kind == Lane::Parking) {
+      if (l.road != 0 && !rng.chance(config_.traffic.parked_on_cross_roads)) continue;
+      spawnParked(l, route, view_range, rng);
+    } else if (l.kind == Lane::Traffic) {
+      spawnCars(l, rng);
+    } else if (l.kind == Lane::Bike) {
+      spawnCyclists(l, route, view_range, rng);
+    } else if (l.kind == Lane::Walk) {
+      spawnPedestrians(l, route, view_range, rng);
+    }
+  }
+}
+
+// The ego: a mid-size car in a lane of the main road's forward direction.
+void Traffic::spawnEgo(Rng& rng) {
+  const TrafficConfig& tc = config_.traffic;
   std::vector<const Lane*> ego_lanes;
   for (const Lane& l : scene_.lanes)
     if (l.road == 0 && l.kind == Lane::Traffic && l.side < 0) ego_lanes.push_back(&l);
@@ -464,185 +492,198 @@ void Traffic::spawn(Rng& rng, double view_range) {
   ego_pose_ = Eigen::Isometry3d::Identity();
   ego_pose_.translation() = Eigen::Vector3d(ego.x, ego.y, ego.z);
   ego_pose_.linear() = Eigen::AngleAxisd(ego.yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+}
 
-  const Path route = main.center.slice(std::max(0.0, scene_.ego_start - 5), scene_.ego_start + scene_.ego_reach + 5, 4.0);
-  auto nearRoute = [&](const V2& p, double r) {
-    for (const auto& q : route.points())
-      if ((q - p).squaredNorm() < r * r) return true;
-    return false;
-  };
-  auto tryAdd = [&](Actor a) {
+void Traffic::tryAdd(Actor a) {
+  place(a);
+  if (overlapsAny(a, worldBox(a))) return;
+  for (const Actor& o : actors)
+    if (boxesOverlap(worldBox(o), worldBox(a), 0.3)) return;
+  if (boxesOverlap(worldBox(ego), worldBox(a), 0.5)) return;
+  a.track_id = next_id_++;
+  actors.push_back(std::move(a));
+}
+
+bool Traffic::nearCrossing(const Eigen::Vector2d& p, double d) const {
+  const Road& main = scene_.roads[0];
+  double lat = 0;
+  const double s = main.center.project(p, &lat);
+  for (double c : scene_.crossings)
+    if (std::abs(c - s) < d && std::abs(lat) < main.half_width + main.sidewalk + 1) return true;
+  return false;
+}
+
+void Traffic::spawnParked(const Lane& l, const Path& route, double view_range, Rng& rng) {
+  const TrafficConfig& tc = config_.traffic;
+  const Path& P = *l.path;
+  const double len = P.length();
+  for (double s = rng.uniform(2, 6); s + 3 < len; s += 6.0) {
+    const PathPose pp = P.at(s);
+    if (!rng.chance(tc.parked_probability)) continue;
+    if (!nearRoute(route, pp.p, view_range + 20) || nearCrossing(pp.p, 7.5) ||
+        scene_.onOtherCarriageway(pp.p, l.road, 7.0))
+      continue;
+    Actor a;
+    drawCar(a, config_, rng);
+    a.path = l.path;
+    a.s = s;
+    a.moving = false;
     place(a);
-    if (overlapsAny(a, worldBox(a))) return false;
-    for (const Actor& o : actors)
-      if (boxesOverlap(worldBox(o), worldBox(a), 0.3)) return false;
-    if (boxesOverlap(worldBox(ego), worldBox(a), 0.5)) return false;
-    a.track_id = next_id_++;
-    actors.push_back(std::move(a));
-    return true;
-  };
-  auto nearCrossing = [&](const V2& p, double d) {
-    double lat = 0;
-    const double s = main.center.project(p, &lat);
-    for (double c : scene_.crossings)
-      if (std::abs(c - s) < d && std::abs(lat) < main.half_width + main.sidewalk + 1) return true;
-    return false;
-  };
+    a.yaw += rng.normal(0, 0.02);
+    const V2 n(-std::sin(pp.yaw), std::cos(pp.yaw));
+    const double shift = rng.normal(0, 0.08);
+    a.x += shift * n.x();
+    a.y += shift * n.y();
+    a.path = nullptr;
+    tryAdd(a);
+  }
+}
 
-  for (const Lane& l : scene_.lanes) {
-    const Path& P = *l.path;
-    const double len = P.length();
-    if (l.kind == Lane::Parking) {
-      if (l.road != 0 && !rng.chance(tc.parked_on_cross_roads)) continue;
-      for (double s = rng.uniform(2, 6); s + 3 < len; s += 6.0) {
-        const PathPose pp = P.at(s);
-        if (!rng.chance(tc.parked_probability)) continue;
-        if (!nearRoute(pp.p, view_range + 20) || nearCrossing(pp.p, 7.5) ||
-            scene_.onOtherCarriageway(pp.p, l.road, 7.0))
-          continue;
-        Actor a;
-        drawCar(a, config_, rng);
-        a.path = l.path;
-        a.s = s;
-        a.moving = false;
-        place(a);
-        a.yaw += rng.normal(0, 0.02);
-        const V2 n(-std::sin(pp.yaw), std::cos(pp.yaw));
-        const double shift = rng.normal(0, 0.08);
-        a.x += shift * n.x();
-        a.y += shift * n.y();
-        a.path = nullptr;
-        tryAdd(a);
-      }
-    } else if (l.kind == Lane::Traffic) {
-      const int n = static_cast<int>(std::round(tc.car_density * len / 100.0 * rng.uniform(0.8, 1.2)));
-      for (int i = 0; i < n; ++i) {
-        Actor a;
-        drawCar(a, config_, rng);
-        a.path = l.path;
-        a.s = rng.uniform(5, len - 10);
-        a.v_cruise = a.v_target = draw(rng, tc.car_speed);
-        a.v = a.v_target;
-        a.next_change = draw(rng, tc.speed_change_interval);
-        // A right turn at the next intersection ahead, for some.
-        if (rng.chance(tc.turn_probability)) {
-          for (std::size_t k = 0; k < scene_.intersections.size(); ++k) {
-            const Intersection& in = scene_.intersections[k];
-            double lat = 0;
-            const double sc = P.project(in.center, &lat);
-            if (std::abs(lat) > 10 || sc < a.s + 15 || sc > len - 20) continue;
-            const double yaw = P.at(sc).yaw;
-            // The lane leaving the intersection to our right: heading = our heading - 90 degrees.
-            for (const Lane& o : scene_.lanes) {
-              if (o.kind != Lane::Traffic || o.index != 0 || (o.road != in.cross_road && o.road != 0) || o.road == l.road) continue;
-              double olat = 0;
-              const double so = o.path->project(in.center, &olat);
-              if (std::abs(olat) > 10) continue;
-              const double oyaw = o.path->at(so).yaw;
-              if (std::abs(std::remainder(oyaw - (yaw - M_PI / 2), 2 * M_PI)) > 0.3) continue;
-              Path route = filletRoute(P, sc, *o.path, so, 7.0);
-              if (!route.empty()) a.path = std::make_shared<const Path>(route);
-              break;
-            }
-            break;
-          }
-        }
-        findStops(a);
-        tryAdd(a);
-      }
-    } else if (l.kind == Lane::Bike) {
-      const int n = static_cast<int>(std::round(tc.cyclist_density * len / 100.0 * rng.uniform(0.8, 1.2)));
-      for (int i = 0; i < n; ++i) {
-        Actor a;
-        a.kind = ActorKind::Cyclist;
-        a.surfaces = drawSurfaces(config_, rng);
-        a.stature = std::clamp(rng.normal(1.76, 0.07), 1.55, 1.95);
-        a.length = std::clamp(rng.normal(1.78, 0.06), 1.6, 1.95);
-        a.phase = rng.uniform(0, 2 * M_PI);
-        fitArticulatedBox(a, rng);
-        a.mesh = actorMesh(a);
-        a.path = l.path;
-        a.s = rng.uniform(5, len - 5);
-        if (!nearRoute(P.at(a.s).p, view_range + 100)) continue;
-        a.v_cruise = a.v_target = draw(rng, tc.cyclist_speed);
-        a.v = a.v_target;
-        a.next_change = draw(rng, tc.speed_change_interval);
-        findStops(a);
-        tryAdd(a);
-      }
-    } else if (l.kind == Lane::Walk) {
-      const Road& road = scene_.roads[l.road];
-      (void)P;
-      const int n = static_cast<int>(std::round(0.5 * tc.pedestrian_density * len / 100.0 * rng.uniform(0.8, 1.2)));
-      for (int i = 0; i < n; ++i) {
-        Actor a;
-        a.kind = ActorKind::Pedestrian;
-        a.surfaces = drawSurfaces(config_, rng);
-        a.stature = std::clamp(rng.normal(1.72, 0.09), 1.45, 2.0);
-        // Shoulder breadth across the arms, clothes included (bideltoid breadth: about 0.50 m in men, 0.43 in women).
-        a.breadth = std::clamp(rng.normal(0.48, 0.035), 0.40, 0.58) * a.stature / 1.72;
-        // Chest depth (anthropometric surveys: 0.22-0.27 m) with clothes; coats and bags vary it.
-        a.depth = std::clamp(rng.normal(0.28, 0.03), 0.22, 0.36) * a.stature / 1.72;
-        a.backpack = rng.chance(0.2);
-        a.v_cruise = draw(rng, tc.pedestrian_speed);
-        a.swing_max = std::clamp(0.22 + 0.12 * a.v_cruise, 0.2, 0.5);
-        a.phase = rng.uniform(0, 2 * M_PI);
-        a.s = rng.uniform(2, len - 2);
-        if (!nearRoute(P.at(a.s).p, view_range + 40)) continue;
-        const bool standing = rng.chance(tc.pedestrian_standing);
-        if (standing) {
-          if (road.sidewalk < 4.0) continue;
-          // Between the two walkways, facing anywhere.
-          const PathPose pp = l.path->at(a.s);
-          double lat = 0;
-          const PathPose rp = road.center.at(road.center.project(pp.p, &lat));
-          const double mid = road.half_width + 0.5 * (1.6 + road.sidewalk - 0.8);
-          const V2 n(-std::sin(rp.yaw), std::cos(rp.yaw));
-          a.moving = false;
-          a.swing_max = 0;
-          fitArticulatedBox(a, rng);
-          a.mesh = actorMesh(a);
-          a.path = std::make_shared<const Path>(std::vector<V2>{rp.p + (lat >= 0 ? mid : -mid) * n,
-                                                                rp.p + (lat >= 0 ? mid : -mid) * n + V2(std::cos(rp.yaw), std::sin(rp.yaw))});
-          a.s = 0;
-          place(a);
-          a.yaw = rng.uniform(-M_PI, M_PI);
-          a.path = nullptr;
-          tryAdd(a);
-          continue;
-        }
-        fitArticulatedBox(a, rng);
-        a.v_target = a.v = a.v_cruise;
-        a.next_change = draw(rng, tc.speed_change_interval);
-        a.path = l.path;
-        // Some cross the main road at the next crossing ahead (from the inner walkway to the far inner walkway).
-        if (l.road == 0 && l.index == 0 && rng.chance(tc.pedestrian_crossing)) {
-          const Path& P = *l.path;
-          for (double c : scene_.crossings) {
-            const V2 cp = main.center.at(c).p;
-            double lat = 0;
-            const double sc = P.project(cp, &lat);
-            if (sc < a.s + 2 || sc > a.s + 60) continue;
-            const Lane* far = nullptr;
-            for (const Lane& o : scene_.lanes)
-              if (o.road == 0 && o.kind == Lane::Walk && o.index == 0 && o.side == -l.side) far = &o;
-            if (!far) break;
-            const double sf = far->path->project(cp);
-            Path route = P.slice(0, sc, 1.0);
-            const V2 a0 = P.at(sc).p, a1 = far->path->at(sf).p;
-            std::vector<V2> across;
-            const int steps = static_cast<int>(std::ceil((a1 - a0).norm()));
-            for (int k = 1; k <= steps; ++k) across.push_back(a0 + (a1 - a0) * (static_cast<double>(k) / steps));
-            route.append(Path(across));
-            route.append(far->path->slice(sf, far->path->length(), 1.0));
-            a.path = std::make_shared<const Path>(route);
-            break;
-          }
-        }
-        a.mesh = actorMesh(a);
-        tryAdd(a);
-      }
+void Traffic::spawnCars(const Lane& l, Rng& rng) {
+  const TrafficConfig& tc = config_.traffic;
+  const double len = l.path->length();
+  const int n = static_cast<int>(std::round(tc.car_density * len / 100.0 * rng.uniform(0.8, 1.2)));
+  for (int i = 0; i < n; ++i) {
+    Actor a;
+    drawCar(a, config_, rng);
+    a.path = l.path;
+    a.s = rng.uniform(5, len - 10);
+    a.v_cruise = a.v_target = draw(rng, tc.car_speed);
+    a.v = a.v_target;
+    a.next_change = draw(rng, tc.speed_change_interval);
+    // A right turn at the next intersection ahead, for some.
+    if (rng.chance(tc.turn_probability)) planRightTurn(a, l);
+    findStops(a);
+    tryAdd(a);
+  }
+}
+
+void Traffic::planRightTurn(Actor& a, const Lane& l) const {
+  const Path& P = *l.path;
+  const double len = P.length();
+  for (std::size_t k = 0; k < scene_.intersections.size(); ++k) {
+    const Intersection& in = scene_.intersections[k];
+    double lat = 0;
+    const double sc = P.project(in.center, &lat);
+    if (std::abs(lat) > 10 || sc < a.s + 15 || sc > len - 20) continue;
+    const double yaw = P.at(sc).yaw;
+    // The lane leaving the intersection to our right: heading = our heading - 90 degrees.
+    for (const Lane& o : scene_.lanes) {
+      if (o.kind != Lane::Traffic || o.index != 0 || (o.road != in.cross_road && o.road != 0) || o.road == l.road) continue;
+      double olat = 0;
+      const double so = o.path->project(in.center, &olat);
+      if (std::abs(olat) > 10) continue;
+      const double oyaw = o.path->at(so).yaw;
+      if (std::abs(std::remainder(oyaw - (yaw - M_PI / 2), 2 * M_PI)) > 0.3) continue;
+      Path route = filletRoute(P, sc, *o.path, so, 7.0);
+      if (!route.empty()) a.path = std::make_shared<const Path>(route);
+      break;
     }
+    break;
+  }
+}
+
+void Traffic::spawnCyclists(const Lane& l, const Path& route, double view_range, Rng& rng) {
+  const TrafficConfig& tc = config_.traffic;
+  const Path& P = *l.path;
+  const double len = P.length();
+  const int n = static_cast<int>(std::round(tc.cyclist_density * len / 100.0 * rng.uniform(0.8, 1.2)));
+  for (int i = 0; i < n; ++i) {
+    Actor a;
+    a.kind = ActorKind::Cyclist;
+    a.surfaces = drawSurfaces(config_, rng);
+    a.stature = std::clamp(rng.normal(1.76, 0.07), 1.55, 1.95);
+    a.length = std::clamp(rng.normal(1.78, 0.06), 1.6, 1.95);
+    a.phase = rng.uniform(0, 2 * M_PI);
+    fitArticulatedBox(a, rng);
+    a.mesh = actorMesh(a);
+    a.path = l.path;
+    a.s = rng.uniform(5, len - 5);
+    if (!nearRoute(route, P.at(a.s).p, view_range + 100)) continue;
+    a.v_cruise = a.v_target = draw(rng, tc.cyclist_speed);
+    a.v = a.v_target;
+    a.next_change = draw(rng, tc.speed_change_interval);
+    findStops(a);
+    tryAdd(a);
+  }
+}
+
+void Traffic::spawnPedestrians(const Lane& l, const Path& route, double view_range, Rng& rng) {
+  const TrafficConfig& tc = config_.traffic;
+  const Road& road = scene_.roads[l.road];
+  const Path& P = *l.path;
+  const double len = P.length();
+  const int n = static_cast<int>(std::round(0.5 * tc.pedestrian_density * len / 100.0 * rng.uniform(0.8, 1.2)));
+  for (int i = 0; i < n; ++i) {
+    Actor a;
+    a.kind = ActorKind::Pedestrian;
+    a.surfaces = drawSurfaces(config_, rng);
+    a.stature = std::clamp(rng.normal(1.72, 0.09), 1.45, 2.0);
+    // Shoulder breadth across the arms, clothes included (bideltoid breadth: about 0.50 m in men, 0.43 in women).
+    a.breadth = std::clamp(rng.normal(0.48, 0.035), 0.40, 0.58) * a.stature / 1.72;
+    // Chest depth (anthropometric surveys: 0.22-0.27 m) with clothes; coats and bags vary it.
+    a.depth = std::clamp(rng.normal(0.28, 0.03), 0.22, 0.36) * a.stature / 1.72;
+    a.backpack = rng.chance(0.2);
+    a.v_cruise = draw(rng, tc.pedestrian_speed);
+    a.swing_max = std::clamp(0.22 + 0.12 * a.v_cruise, 0.2, 0.5);
+    a.phase = rng.uniform(0, 2 * M_PI);
+    a.s = rng.uniform(2, len - 2);
+    if (!nearRoute(route, P.at(a.s).p, view_range + 40)) continue;
+    const bool standing = rng.chance(tc.pedestrian_standing);
+    if (standing) {
+      if (road.sidewalk < 4.0) continue;
+      // Between the two walkways, facing anywhere.
+      const PathPose pp = l.path->at(a.s);
+      double lat = 0;
+      const PathPose rp = road.center.at(road.center.project(pp.p, &lat));
+      const double mid = road.half_width + 0.5 * (1.6 + road.sidewalk - 0.8);
+      const V2 n(-std::sin(rp.yaw), std::cos(rp.yaw));
+      a.moving = false;
+      a.swing_max = 0;
+      fitArticulatedBox(a, rng);
+      a.mesh = actorMesh(a);
+      a.path = std::make_shared<const Path>(std::vector<V2>{rp.p + (lat >= 0 ? mid : -mid) * n,
+                                                            rp.p + (lat >= 0 ? mid : -mid) * n + V2(std::cos(rp.yaw), std::sin(rp.yaw))});
+      a.s = 0;
+      place(a);
+      a.yaw = rng.uniform(-M_PI, M_PI);
+      a.path = nullptr;
+      tryAdd(a);
+      continue;
+    }
+    fitArticulatedBox(a, rng);
+    a.v_target = a.v = a.v_cruise;
+    a.next_change = draw(rng, tc.speed_change_interval);
+    a.path = l.path;
+    // Some cross the main road at the next crossing ahead (from the inner walkway to the far inner walkway).
+    if (l.road == 0 && l.index == 0 && rng.chance(tc.pedestrian_crossing)) planCrossing(a, l);
+    a.mesh = actorMesh(a);
+    tryAdd(a);
+  }
+}
+
+void Traffic::planCrossing(Actor& a, const Lane& l) const {
+  const Road& main = scene_.roads[0];
+  const Path& P = *l.path;
+  for (double c : scene_.crossings) {
+    const V2 cp = main.center.at(c).p;
+    double lat = 0;
+    const double sc = P.project(cp, &lat);
+    if (sc < a.s + 2 || sc > a.s + 60) continue;
+    const Lane* far = nullptr;
+    for (const Lane& o : scene_.lanes)
+      if (o.road == 0 && o.kind == Lane::Walk && o.index == 0 && o.side == -l.side) far = &o;
+    if (!far) break;
+    const double sf = far->path->project(cp);
+    Path route = P.slice(0, sc, 1.0);
+    const V2 a0 = P.at(sc).p, a1 = far->path->at(sf).p;
+    std::vector<V2> across;
+    const int steps = static_cast<int>(std::ceil((a1 - a0).norm()));
+    for (int k = 1; k <= steps; ++k) across.push_back(a0 + (a1 - a0) * (static_cast<double>(k) / steps));
+    route.append(Path(across));
+    route.append(far->path->slice(sf, far->path->length(), 1.0));
+    a.path = std::make_shared<const Path>(route);
+    break;
   }
 }
 

@@ -35,6 +35,17 @@ RTCGeometry makeMesh(RTCDevice device, const TriangleMesh& mesh) {
   return g;
 }
 
+// A committed scene holding the mesh alone (to be instanced).
+RTCScene meshScene(RTCDevice device, const TriangleMesh& mesh, RTCBuildQuality quality) {
+  RTCScene scene = rtcNewScene(device);
+  rtcSetSceneBuildQuality(scene, quality);
+  RTCGeometry g = makeMesh(device, mesh);
+  rtcAttachGeometry(scene, g);
+  rtcReleaseGeometry(g);
+  rtcCommitScene(scene);
+  return scene;
+}
+
 void setTransform(RTCGeometry inst, const Eigen::Isometry3d& T) {
   float m[12];
   const Eigen::Matrix<double, 3, 4> M = T.matrix().topRows<3>();
@@ -121,12 +132,7 @@ void RayCaster::setStatic(const TriangleMesh& mesh) {
     rtcDetachGeometry(m.top, 0);
     rtcReleaseScene(m.static_scene);
   }
-  m.static_scene = rtcNewScene(m.device);
-  rtcSetSceneBuildQuality(m.static_scene, RTC_BUILD_QUALITY_HIGH);
-  RTCGeometry g = makeMesh(m.device, mesh);
-  rtcAttachGeometry(m.static_scene, g);
-  rtcReleaseGeometry(g);
-  rtcCommitScene(m.static_scene);
+  m.static_scene = meshScene(m.device, mesh, RTC_BUILD_QUALITY_HIGH);
   m.static_surfaces = mesh.surfaces;
   m.static_inst = rtcNewGeometry(m.device, RTC_GEOMETRY_TYPE_INSTANCE);
   rtcSetGeometryInstancedScene(m.static_inst, m.static_scene);
@@ -152,12 +158,7 @@ void RayCaster::setActor(std::size_t i, const TriangleMesh& mesh, const Eigen::I
   auto it = a.variants.find(variant);
   if (it == a.variants.end()) {
     Impl::Variant v;
-    v.scene = rtcNewScene(m.device);
-    rtcSetSceneBuildQuality(v.scene, RTC_BUILD_QUALITY_MEDIUM);
-    RTCGeometry g = makeMesh(m.device, mesh);
-    rtcAttachGeometry(v.scene, g);
-    rtcReleaseGeometry(g);
-    rtcCommitScene(v.scene);
+    v.scene = meshScene(m.device, mesh, RTC_BUILD_QUALITY_MEDIUM);
     v.surfaces = mesh.surfaces;
     it = a.variants.emplace(variant, std::move(v)).first;
   }

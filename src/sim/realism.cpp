@@ -9,6 +9,7 @@
 #include <unordered_map>
 
 #include "ret3d/core/geometry.h"
+#include "ret3d/core/stats.h"
 #include "ret3d/io/kitti.h"
 
 namespace ret3d {
@@ -88,9 +89,7 @@ double ScanStats::medianCarPoints(double lo, double hi) const {
   std::vector<double> v;
   for (const auto& [d, n] : cars)
     if (d >= lo && d <= hi) v.push_back(n);
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+  return median(std::move(v));
 }
 
 void ScanStats::write(const std::string& prefix) const {

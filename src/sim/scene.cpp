@@ -347,370 +347,476 @@ bool footprintFree(const Scene& scene, const Box& b, double margin, const std::v
   return !hitsKeepOut(keep_out, b);
 }
 
-}  // namespace
+// Builds Scene::mesh: ground, sidewalks and markings near the ego's route, then the clutter beside every road. The
+// parts draw from `rng` (and the clutter's `extra` stream) in a fixed order, so a seed gives the same scene.
+class StaticGeometryBuilder {
+ public:
+  StaticGeometryBuilder(Scene& scene, const SimConfig& config, Rng& rng, double view_range,
+                        const std::vector<Box>& keep_out)
+      : scene(scene),
+        config(config),
+        rc(config.road),
+        cc(config.clutter),
+        rng(rng),
+        view_range(view_range),
+        keep_out(keep_out),
+        mesh(scene.mesh),
+        main(scene.roads[0]),
+        // The ego's route: only geometry within view_range of it can be seen.
+        route(main.center.slice(std::max(0.0, scene.ego_start - 5), scene.ego_start + scene.ego_reach + 5, 2.0)) {}
 
-void buildStaticGeometry(Scene& scene, const SimConfig& config, Rng& rng, double view_range,
-                         const std::vector<Box>& keep_out) {
-  const RoadConfig& rc = config.road;
-  const ClutterConfig& cc = config.clutter;
-  TriangleMesh& mesh = scene.mesh;
-  mesh.clear();
-  const Road& main = scene.roads[0];
+  void build() {
+    mesh.clear();
+    ground();
+    roads();
+    crossings();
+    clutter();
+  }
 
-  // The ego's route: only geometry within view_range of it can be seen.
-  const Path route = main.center.slice(std::max(0.0, scene.ego_start - 5), scene.ego_start + scene.ego_reach + 5, 2.0);
-  auto nearRoute = [&](const V2& p, double extra) {
+ private:
+  // One piece of a road's centre line between two of its samples, with the normals and heights at both ends.
+  struct Segment {
+    const Road& road;
+    std::size_t r, i;
+    V2 mid, n0, n1;
+    double z0, z1;
+  };
+
+  bool nearRoute(const V2& p, double extra) const {
     // Coarse: distance to the route's 2 m samples.
     for (const auto& q : route.points())
       if ((q - p).squaredNorm() < (view_range + extra) * (view_range + extra)) return true;
     return false;
-  };
+  }
 
-  // Ground heightfield over the bounding box of the route plus view range, cells beyond view range skipped.
-  Eigen::AlignedBox2d bb;
-  for (const auto& q : route.points()) bb.extend(q);
-  bb.min() -= V2(view_range, view_range);
-  bb.max() += V2(view_range, view_range);
-  double cell = config.ground.grid_cell;
-  while ((bb.sizes().x() / cell) * (bb.sizes().y() / cell) > 1.2e6) cell *= 1.5;  // keep the mesh bounded
-  const int nx = static_cast<int>(std::ceil(bb.sizes().x() / cell)) + 1;
-  const int ny = static_cast<int>(std::ceil(bb.sizes().y() / cell)) + 1;
-  // Distance from each grid column band to the route, so that far cells are skipped cheaply: a coarse raster.
-  const double coarse = 10.0;
-  const int cx = static_cast<int>(std::ceil(bb.sizes().x() / coarse)) + 1, cy = static_cast<int>(std::ceil(bb.sizes().y() / coarse)) + 1;
-  std::vector<char> keep(static_cast<std::size_t>(cx) * cy, 0);
-  for (const auto& q : route.points()) {
-    const int r = static_cast<int>(std::ceil((view_range + 15) / coarse));
-    const int qx = static_cast<int>((q.x() - bb.min().x()) / coarse), qy = static_cast<int>((q.y() - bb.min().y()) / coarse);
-    for (int ix = std::max(0, qx - r); ix <= std::min(cx - 1, qx + r); ++ix)
-      for (int iy = std::max(0, qy - r); iy <= std::min(cy - 1, qy + r); ++iy) {
-        const V2 c = bb.min() + V2((ix + 0.5) * coarse, (iy + 0.5) * coarse);
-        if ((c - q).norm() < view_range + 15) keep[static_cast<std::size_t>(ix) * cy + iy] = 1;
-      }
-  }
-  std::vector<float> height(static_cast<std::size_t>(nx) * ny, 0.0f);
-  std::vector<float> dist(static_cast<std::size_t>(nx) * ny, 0.0f);
-  std::vector<std::uint32_t> vid(static_cast<std::size_t>(nx) * ny, 0xffffffffu);
-  auto cellKept = [&](int i, int j) {
-    const int ix = static_cast<int>(i * cell / coarse), iy = static_cast<int>(j * cell / coarse);
-    return keep[static_cast<std::size_t>(std::min(ix, cx - 1)) * cy + std::min(iy, cy - 1)] != 0;
-  };
-  for (int i = 0; i < nx; ++i) {
-    for (int j = 0; j < ny; ++j) {
-      // A vertex is needed when any of its four cells is kept.
-      bool need = false;
-      for (int di = -1; di <= 0 && !need; ++di)
-        for (int dj = -1; dj <= 0 && !need; ++dj)
-          if (i + di >= 0 && j + dj >= 0 && i + di < nx - 1 && j + dj < ny - 1) need = cellKept(i + di, j + dj);
-      if (!need) continue;
-      const double x = bb.min().x() + i * cell, y = bb.min().y() + j * cell;
-      const std::size_t k = static_cast<std::size_t>(i) * ny + j;
-      height[k] = static_cast<float>(scene.groundHeight(x, y));
-      dist[k] = static_cast<float>(scene.roadDistance(V2(x, y)));
-      vid[k] = static_cast<std::uint32_t>(mesh.vertices.size());
-      mesh.vertices.emplace_back(static_cast<float>(x), static_cast<float>(y), height[k]);
+  void ground() {
+    // Ground heightfield over the bounding box of the route plus view range, cells beyond view range skipped.
+    Eigen::AlignedBox2d bb;
+    for (const auto& q : route.points()) bb.extend(q);
+    bb.min() -= V2(view_range, view_range);
+    bb.max() += V2(view_range, view_range);
+    double cell = config.ground.grid_cell;
+    while ((bb.sizes().x() / cell) * (bb.sizes().y() / cell) > 1.2e6) cell *= 1.5;  // keep the mesh bounded
+    const int nx = static_cast<int>(std::ceil(bb.sizes().x() / cell)) + 1;
+    const int ny = static_cast<int>(std::ceil(bb.sizes().y() / cell)) + 1;
+    // Distance from each grid column band to the route, so that far cells are skipped cheaply: a coarse raster.
+    const double coarse = 10.0;
+    const int cx = static_cast<int>(std::ceil(bb.sizes().x() / coarse)) + 1, cy = static_cast<int>(std::ceil(bb.sizes().y() / coarse)) + 1;
+    std::vector<char> keep(static_cast<std::size_t>(cx) * cy, 0);
+    for (const auto& q : route.points()) {
+      const int r = static_cast<int>(std::ceil((view_range + 15) / coarse));
+      const int qx = static_cast<int>((q.x() - bb.min().x()) / coarse), qy = static_cast<int>((q.y() - bb.min().y()) / coarse);
+      for (int ix = std::max(0, qx - r); ix <= std::min(cx - 1, qx + r); ++ix)
+        for (int iy = std::max(0, qy - r); iy <= std::min(cy - 1, qy + r); ++iy) {
+          const V2 c = bb.min() + V2((ix + 0.5) * coarse, (iy + 0.5) * coarse);
+          if ((c - q).norm() < view_range + 15) keep[static_cast<std::size_t>(ix) * cy + iy] = 1;
+        }
     }
-  }
-  for (int i = 0; i + 1 < nx; ++i) {
-    for (int j = 0; j + 1 < ny; ++j) {
-      if (!cellKept(i, j)) continue;
-      const std::size_t a = static_cast<std::size_t>(i) * ny + j, b = a + ny, c = a + ny + 1, d = a + 1;
-      if (vid[a] == 0xffffffffu || vid[b] == 0xffffffffu || vid[c] == 0xffffffffu || vid[d] == 0xffffffffu) continue;
-      const double dm = 0.25 * (dist[a] + dist[b] + dist[c] + dist[d]);
-      const char* mat = dm < 0 ? "asphalt" : (dm < rc.sidewalk_width ? "concrete" : "terrain");
-      const Surface s = drawSurface(config, mat, rng);
-      mesh.triangles.push_back({vid[a], vid[b], vid[c]});
-      mesh.triangles.push_back({vid[a], vid[c], vid[d]});
-      mesh.surfaces.push_back(s);
-      mesh.surfaces.push_back(s);
+    std::vector<float> height(static_cast<std::size_t>(nx) * ny, 0.0f);
+    std::vector<float> dist(static_cast<std::size_t>(nx) * ny, 0.0f);
+    std::vector<std::uint32_t> vid(static_cast<std::size_t>(nx) * ny, 0xffffffffu);
+    auto cellKept = [&](int i, int j) {
+      const int ix = static_cast<int>(i * cell / coarse), iy = static_cast<int>(j * cell / coarse);
+      return keep[static_cast<std::size_t>(std::min(ix, cx - 1)) * cy + std::min(iy, cy - 1)] != 0;
+    };
+    for (int i = 0; i < nx; ++i) {
+      for (int j = 0; j < ny; ++j) {
+        // A vertex is needed when any of its four cells is kept.
+        bool need = false;
+        for (int di = -1; di <= 0 && !need; ++di)
+          for (int dj = -1; dj <= 0 && !need; ++dj)
+            if (i + di >= 0 && j + dj >= 0 && i + di < nx - 1 && j + dj < ny - 1) need = cellKept(i + di, j + dj);
+        if (!need) continue;
+        const double x = bb.min().x() + i * cell, y = bb.min().y() + j * cell;
+        const std::size_t k = static_cast<std::size_t>(i) * ny + j;
+        height[k] = static_cast<float>(scene.groundHeight(x, y));
+        dist[k] = static_cast<float>(scene.roadDistance(V2(x, y)));
+        vid[k] = static_cast<std::uint32_t>(mesh.vertices.size());
+        mesh.vertices.emplace_back(static_cast<float>(x), static_cast<float>(y), height[k]);
+      }
+    }
+    for (int i = 0; i + 1 < nx; ++i) {
+      for (int j = 0; j + 1 < ny; ++j) {
+        if (!cellKept(i, j)) continue;
+        const std::size_t a = static_cast<std::size_t>(i) * ny + j, b = a + ny, c = a + ny + 1, d = a + 1;
+        if (vid[a] == 0xffffffffu || vid[b] == 0xffffffffu || vid[c] == 0xffffffffu || vid[d] == 0xffffffffu) continue;
+        const double dm = 0.25 * (dist[a] + dist[b] + dist[c] + dist[d]);
+        const char* mat = dm < 0 ? "asphalt" : (dm < rc.sidewalk_width ? "concrete" : "terrain");
+        const Surface s = drawSurface(config, mat, rng);
+        mesh.triangles.push_back({vid[a], vid[b], vid[c]});
+        mesh.triangles.push_back({vid[a], vid[c], vid[d]});
+        mesh.surfaces.push_back(s);
+        mesh.surfaces.push_back(s);
+      }
     }
   }
 
   // Sidewalks with curbs, and lane markings, on every road near the route.
-  for (std::size_t r = 0; r < scene.roads.size(); ++r) {
-    const Road& road = scene.roads[r];
-    const auto& pts = road.center.points();
-    const double W = road.half_width;
-    for (std::size_t i = 0; i + 1 < pts.size(); ++i) {
-      const V2 mid = 0.5 * (pts[i] + pts[i + 1]);
-      if (!nearRoute(mid, 20)) continue;
-      const double yaw0 = road.center.at(road.center.stations()[i]).yaw;
-      const double yaw1 = road.center.at(road.center.stations()[i + 1]).yaw;
-      const V2 n0 = normalLeft(yaw0), n1 = normalLeft(yaw1);
-      const double z0 = road.z.empty() ? 0.0 : road.z[i], z1 = road.z.empty() ? 0.0 : road.z[i + 1];
-      if (road.sidewalk > 0) {
-        for (int side = -1; side <= 1; side += 2) {
-          const V2 a0 = pts[i] + side * W * n0, a1 = pts[i + 1] + side * W * n1;
-          const V2 b0 = pts[i] + side * (W + road.sidewalk) * n0, b1 = pts[i + 1] + side * (W + road.sidewalk) * n1;
-          if (scene.onOtherCarriageway(0.5 * (a0 + a1), static_cast<int>(r), 0.2) ||
-              scene.onOtherCarriageway(0.5 * (b0 + b1), static_cast<int>(r), 0.2))
-            continue;
-          const float h = static_cast<float>(rc.curb_height);
-          auto v = [](const V2& p, double z) { return V3f(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(z)); };
-          const Surface top = drawSurface(config, "concrete", rng), curb = drawSurface(config, "curb", rng);
-          mesh.addQuad(v(a0, z0 + h), v(a1, z1 + h), v(b1, z1 + h), v(b0, z0 + h), top);
-          mesh.addQuad(v(a0, z0 - 0.1), v(a1, z1 - 0.1), v(a1, z1 + h), v(a0, z0 + h), curb);
-          mesh.addQuad(v(b0, z0 - 0.1), v(b1, z1 - 0.1), v(b1, z1 + h), v(b0, z0 + h), curb);
-        }
-      }
-      // Markings: centre line (dashed) or median barrier, lane dividers (dashed), edge lines (solid).
-      const double s = road.center.stations()[i];
-      const bool dash_on = std::fmod(s, rc.marking_dash + rc.marking_gap) < rc.marking_dash;
-      const int lanes = road.main ? rc.lanes_per_direction : 1;
-      const double med = road.main ? 0.5 * rc.median_width : 0.0;
-      std::vector<std::pair<double, double>> lines;  // (offset, width)
-      if (road.main && rc.median_width > 0) {
-        const Surface conc = drawSurface(config, "concrete", rng);
-        if (!scene.onOtherCarriageway(mid, static_cast<int>(r), 0.0))
-          addWall(mesh, pts[i], pts[i + 1], 0.6, z0 - 0.05, z0 + 0.85, conc);
-      } else if (dash_on) {
-        lines.emplace_back(0.0, 0.12);
-      }
-      for (int side = -1; side <= 1; side += 2) {
-        for (int l = 1; l < lanes; ++l)
-          if (dash_on) lines.emplace_back(side * (med + l * rc.lane_width), 0.12);
-        if (rc.bike_lane_width + rc.parking_lane_width + rc.shoulder_width > 0)
-          lines.emplace_back(side * (med + lanes * rc.lane_width), 0.15);
-        if (road.main && rc.median_width > 0) lines.emplace_back(side * (med + 0.3), 0.15);
-      }
-      if (scene.onOtherCarriageway(mid, static_cast<int>(r), 0.5)) lines.clear();
-      const Surface paint = drawSurface(config, "marking", rng);
-      for (const auto& [off, w] : lines) {
-        const V2 p0 = pts[i] + (off - 0.5 * w) * n0, p1 = pts[i + 1] + (off - 0.5 * w) * n1;
-        const V2 q0 = pts[i] + (off + 0.5 * w) * n0, q1 = pts[i + 1] + (off + 0.5 * w) * n1;
-        auto v = [&](const V2& p) {
-          return V3f(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(scene.groundHeight(p.x(), p.y()) + 0.006));
-        };
-        mesh.addQuad(v(p0), v(p1), v(q1), v(q0), paint);
-      }
-      // Guard rails along the outer edge (highway).
-      if (cc.guard_rail > 0.5 && i % 2 == 0) {
-        const Surface metal = drawSurface(config, "metal", rng);
-        for (int side = -1; side <= 1; side += 2) {
-          const V2 g0 = pts[i] + side * (W + 0.5) * n0, g1 = pts[std::min(i + 2, pts.size() - 1)] + side * (W + 0.5) * normalLeft(road.center.at(road.center.stations()[std::min(i + 2, pts.size() - 1)]).yaw);
-          if (scene.onOtherCarriageway(g0, static_cast<int>(r), 0.5)) continue;
-          mesh.addBeam(V3f(static_cast<float>(g0.x()), static_cast<float>(g0.y()), static_cast<float>(z0 - 0.1)),
-                       V3f(static_cast<float>(g0.x()), static_cast<float>(g0.y()), static_cast<float>(z0 + 0.75)), 0.12f, metal);
-          addWall(mesh, g0, g1, 0.08, z0 + 0.45, z0 + 0.75, metal);
-        }
+  void roads() {
+    for (std::size_t r = 0; r < scene.roads.size(); ++r) {
+      const Road& road = scene.roads[r];
+      const auto& pts = road.center.points();
+      for (std::size_t i = 0; i + 1 < pts.size(); ++i) {
+        const V2 mid = 0.5 * (pts[i] + pts[i + 1]);
+        if (!nearRoute(mid, 20)) continue;
+        const double yaw0 = road.center.at(road.center.stations()[i]).yaw;
+        const double yaw1 = road.center.at(road.center.stations()[i + 1]).yaw;
+        const Segment seg{road, r, i, mid, normalLeft(yaw0), normalLeft(yaw1), road.z.empty() ? 0.0 : road.z[i],
+                          road.z.empty() ? 0.0 : road.z[i + 1]};
+        if (road.sidewalk > 0) sidewalks(seg);
+        markings(seg);
+        guardRails(seg);
       }
     }
   }
-  // Zebra crossings on the main road.
-  for (double sc : scene.crossings) {
-    const PathPose pp = main.center.at(sc);
-    if (!nearRoute(pp.p, 20)) continue;
-    const V2 t = dir(pp.yaw), n = normalLeft(pp.yaw);
-    const double w = main.half_width - rc.parking_lane_width - 0.3;
+
+  void sidewalks(const Segment& seg) {
+    const Road& road = seg.road;
+    const auto& pts = road.center.points();
+    const std::size_t r = seg.r, i = seg.i;
+    const double W = road.half_width;
+    const V2 n0 = seg.n0, n1 = seg.n1;
+    const double z0 = seg.z0, z1 = seg.z1;
+    for (int side = -1; side <= 1; side += 2) {
+      const V2 a0 = pts[i] + side * W * n0, a1 = pts[i + 1] + side * W * n1;
+      const V2 b0 = pts[i] + side * (W + road.sidewalk) * n0, b1 = pts[i + 1] + side * (W + road.sidewalk) * n1;
+      if (scene.onOtherCarriageway(0.5 * (a0 + a1), static_cast<int>(r), 0.2) ||
+          scene.onOtherCarriageway(0.5 * (b0 + b1), static_cast<int>(r), 0.2))
+        continue;
+      const float h = static_cast<float>(rc.curb_height);
+      auto v = [](const V2& p, double z) { return V3f(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(z)); };
+      const Surface top = drawSurface(config, "concrete", rng), curb = drawSurface(config, "curb", rng);
+      mesh.addQuad(v(a0, z0 + h), v(a1, z1 + h), v(b1, z1 + h), v(b0, z0 + h), top);
+      mesh.addQuad(v(a0, z0 - 0.1), v(a1, z1 - 0.1), v(a1, z1 + h), v(a0, z0 + h), curb);
+      mesh.addQuad(v(b0, z0 - 0.1), v(b1, z1 - 0.1), v(b1, z1 + h), v(b0, z0 + h), curb);
+    }
+  }
+
+  void markings(const Segment& seg) {
+    const Road& road = seg.road;
+    const auto& pts = road.center.points();
+    const std::size_t r = seg.r, i = seg.i;
+    const V2 mid = seg.mid, n0 = seg.n0, n1 = seg.n1;
+    const double z0 = seg.z0;
+    // Markings: centre line (dashed) or median barrier, lane dividers (dashed), edge lines (solid).
+    const double s = road.center.stations()[i];
+    const bool dash_on = std::fmod(s, rc.marking_dash + rc.marking_gap) < rc.marking_dash;
+    const int lanes = road.main ? rc.lanes_per_direction : 1;
+    const double med = road.main ? 0.5 * rc.median_width : 0.0;
+    std::vector<std::pair<double, double>> lines;  // (offset, width)
+    if (road.main && rc.median_width > 0) {
+      const Surface conc = drawSurface(config, "concrete", rng);
+      if (!scene.onOtherCarriageway(mid, static_cast<int>(r), 0.0))
+        addWall(mesh, pts[i], pts[i + 1], 0.6, z0 - 0.05, z0 + 0.85, conc);
+    } else if (dash_on) {
+      lines.emplace_back(0.0, 0.12);
+    }
+    for (int side = -1; side <= 1; side += 2) {
+      for (int l = 1; l < lanes; ++l)
+        if (dash_on) lines.emplace_back(side * (med + l * rc.lane_width), 0.12);
+      if (rc.bike_lane_width + rc.parking_lane_width + rc.shoulder_width > 0)
+        lines.emplace_back(side * (med + lanes * rc.lane_width), 0.15);
+      if (road.main && rc.median_width > 0) lines.emplace_back(side * (med + 0.3), 0.15);
+    }
+    if (scene.onOtherCarriageway(mid, static_cast<int>(r), 0.5)) lines.clear();
     const Surface paint = drawSurface(config, "marking", rng);
-    for (double o = -w; o + 0.5 <= w; o += 1.0) {
-      V2 c[4] = {pp.p - 1.5 * t + o * n, pp.p + 1.5 * t + o * n, pp.p + 1.5 * t + (o + 0.5) * n, pp.p - 1.5 * t + (o + 0.5) * n};
-      V3f v[4];
-      for (int k = 0; k < 4; ++k)
-        v[k] = V3f(static_cast<float>(c[k].x()), static_cast<float>(c[k].y()), static_cast<float>(scene.groundHeight(c[k].x(), c[k].y()) + 0.006));
-      mesh.addQuad(v[0], v[1], v[2], v[3], paint);
+    for (const auto& [off, w] : lines) {
+      const V2 p0 = pts[i] + (off - 0.5 * w) * n0, p1 = pts[i + 1] + (off - 0.5 * w) * n1;
+      const V2 q0 = pts[i] + (off + 0.5 * w) * n0, q1 = pts[i + 1] + (off + 0.5 * w) * n1;
+      auto v = [&](const V2& p) {
+        return V3f(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(scene.groundHeight(p.x(), p.y()) + 0.006));
+      };
+      mesh.addQuad(v(p0), v(p1), v(q1), v(q0), paint);
+    }
+  }
+
+  void guardRails(const Segment& seg) {
+    const Road& road = seg.road;
+    const auto& pts = road.center.points();
+    const std::size_t r = seg.r, i = seg.i;
+    const double W = road.half_width;
+    const V2 n0 = seg.n0;
+    const double z0 = seg.z0;
+    // Guard rails along the outer edge (highway).
+    if (cc.guard_rail > 0.5 && i % 2 == 0) {
+      const Surface metal = drawSurface(config, "metal", rng);
+      for (int side = -1; side <= 1; side += 2) {
+        const V2 g0 = pts[i] + side * (W + 0.5) * n0, g1 = pts[std::min(i + 2, pts.size() - 1)] + side * (W + 0.5) * normalLeft(road.center.at(road.center.stations()[std::min(i + 2, pts.size() - 1)]).yaw);
+        if (scene.onOtherCarriageway(g0, static_cast<int>(r), 0.5)) continue;
+        mesh.addBeam(V3f(static_cast<float>(g0.x()), static_cast<float>(g0.y()), static_cast<float>(z0 - 0.1)),
+                     V3f(static_cast<float>(g0.x()), static_cast<float>(g0.y()), static_cast<float>(z0 + 0.75)), 0.12f, metal);
+        addWall(mesh, g0, g1, 0.08, z0 + 0.45, z0 + 0.75, metal);
+      }
+    }
+  }
+
+  // Zebra crossings on the main road.
+  void crossings() {
+    for (double sc : scene.crossings) {
+      const PathPose pp = main.center.at(sc);
+      if (!nearRoute(pp.p, 20)) continue;
+      const V2 t = dir(pp.yaw), n = normalLeft(pp.yaw);
+      const double w = main.half_width - rc.parking_lane_width - 0.3;
+      const Surface paint = drawSurface(config, "marking", rng);
+      for (double o = -w; o + 0.5 <= w; o += 1.0) {
+        V2 c[4] = {pp.p - 1.5 * t + o * n, pp.p + 1.5 * t + o * n, pp.p + 1.5 * t + (o + 0.5) * n, pp.p - 1.5 * t + (o + 0.5) * n};
+        V3f v[4];
+        for (int k = 0; k < 4; ++k)
+          v[k] = V3f(static_cast<float>(c[k].x()), static_cast<float>(c[k].y()), static_cast<float>(scene.groundHeight(c[k].x(), c[k].y()) + 0.006));
+        mesh.addQuad(v[0], v[1], v[2], v[3], paint);
+      }
     }
   }
 
   // Clutter along both sides of every road: buildings with windows, walls or fences in the gaps, trees, poles, signs.
-  Rng extra(mix64(scene.noise_seed ^ 0x6865646765ULL));  // hedges, bushes, bollards
-  for (std::size_t r = 0; r < scene.roads.size(); ++r) {
-    const Road& road = scene.roads[r];
+  void clutter() {
+    Rng extra(mix64(scene.noise_seed ^ 0x6865646765ULL));  // hedges, bushes, bollards
+    for (std::size_t r = 0; r < scene.roads.size(); ++r) {
+      for (int side = -1; side <= 1; side += 2) {
+        const Road& road = scene.roads[r];
+        frontage(road, side);
+        if (cc.hedge_probability > 0) hedges(road, side, extra);
+        if (cc.bush_spacing.hi > 0) bushes(road, side, extra);
+        if (cc.bollard_spacing.hi > 0 && road.sidewalk > 0) bollards(road, r, side, extra);
+        trees(road, r, side);
+        polesAndSigns(road, r, side);
+      }
+    }
+  }
+
+  // Frontage: buildings and gaps.
+  void frontage(const Road& road, int side) {
     const double L = road.center.length();
     const double W = road.half_width, SW = road.sidewalk;
-    for (int side = -1; side <= 1; side += 2) {
-      // Frontage: buildings and gaps.
-      for (double s = rng.uniform(0, 10); s < L;) {
-        const double f = draw(rng, cc.building_frontage);
-        const PathPose pp = road.center.at(s + 0.5 * f);
-        const V2 n = normalLeft(pp.yaw);
-        const double setback = draw(rng, cc.building_setback);
-        if (nearRoute(pp.p, 30)) {
-          if (rng.chance(cc.building_probability)) {
-            const double depth = draw(rng, cc.building_depth), height = draw(rng, cc.building_height);
-            Box b;
-            const V2 c = pp.p + side * (W + SW + setback + 0.5 * depth) * n;
-            b.x = c.x();
-            b.y = c.y();
-            b.length = f;
-            b.width = depth;
-            b.yaw = pp.yaw;
-            if (footprintFree(scene, b, 0.3, keep_out)) {
-              const double z0 = scene.baseHeight(c) - 0.5;
-              const Surface wall = drawSurface(config, "building", rng);
-              mesh.addBox(poseAt(c, z0 + 0.5 * (height + 0.5), pp.yaw), V3f(static_cast<float>(f), static_cast<float>(depth), static_cast<float>(height + 0.5)), wall, false);
-              // Windows on the street facade, slightly proud of it.
-              const Surface glass = drawSurface(config, "glass", rng);
-              const V2 face = c - side * 0.5 * depth * n - side * 0.03 * n;
-              const V2 t = dir(pp.yaw);
-              for (double fz = 1.0; fz + 1.6 < height; fz += 3.0) {
-                for (double fx = -0.5 * f + 1.0; fx + 1.3 < 0.5 * f; fx += 2.6) {
-                  const V2 a = face + fx * t, bq = face + (fx + 1.3) * t;
-                  const double zb = z0 + 0.5 + fz;
-                  mesh.addQuad(V3f(a.x(), a.y(), zb), V3f(bq.x(), bq.y(), zb), V3f(bq.x(), bq.y(), zb + 1.5),
-                               V3f(a.x(), a.y(), zb + 1.5), glass);
-                }
-              }
-            }
-          } else if (rng.chance(cc.wall_probability)) {
-            const double h = draw(rng, cc.wall_height);
-            const V2 a = road.center.at(s).p + side * (W + SW + setback) * normalLeft(road.center.at(s).yaw);
-            const V2 e = road.center.at(s + f).p + side * (W + SW + setback) * normalLeft(road.center.at(s + f).yaw);
-            Box b;
-            b.x = 0.5 * (a.x() + e.x());
-            b.y = 0.5 * (a.y() + e.y());
-            b.length = (e - a).norm();
-            b.width = 0.3;
-            b.yaw = std::atan2(e.y() - a.y(), e.x() - a.x());
-            if (footprintFree(scene, b, 0.2, keep_out)) {
-              const double z0 = scene.groundHeight(b.x, b.y);
-              if (rng.chance(cc.fence_fraction)) {
-                const Surface metal = drawSurface(config, "metal", rng);
-                const int posts = std::max(1, static_cast<int>(b.length / 2.5));
-                for (int k = 0; k <= posts; ++k) {
-                  const V2 p = a + (e - a) * (static_cast<double>(k) / posts);
-                  mesh.addBeam(V3f(p.x(), p.y(), z0 - 0.2), V3f(p.x(), p.y(), z0 + h), 0.07f, metal);
-                }
-                for (double rz : {0.35 * h, 0.95 * h}) addWall(mesh, a, e, 0.05, z0 + rz - 0.03, z0 + rz + 0.03, metal);
-              } else {
-                addWall(mesh, a, e, 0.25, z0 - 0.3, z0 + h, drawSurface(config, "building", rng));
+    for (double s = rng.uniform(0, 10); s < L;) {
+      const double f = draw(rng, cc.building_frontage);
+      const PathPose pp = road.center.at(s + 0.5 * f);
+      const V2 n = normalLeft(pp.yaw);
+      const double setback = draw(rng, cc.building_setback);
+      if (nearRoute(pp.p, 30)) {
+        if (rng.chance(cc.building_probability)) {
+          const double depth = draw(rng, cc.building_depth), height = draw(rng, cc.building_height);
+          Box b;
+          const V2 c = pp.p + side * (W + SW + setback + 0.5 * depth) * n;
+          b.x = c.x();
+          b.y = c.y();
+          b.length = f;
+          b.width = depth;
+          b.yaw = pp.yaw;
+          if (footprintFree(scene, b, 0.3, keep_out)) {
+            const double z0 = scene.baseHeight(c) - 0.5;
+            const Surface wall = drawSurface(config, "building", rng);
+            mesh.addBox(poseAt(c, z0 + 0.5 * (height + 0.5), pp.yaw), V3f(static_cast<float>(f), static_cast<float>(depth), static_cast<float>(height + 0.5)), wall, false);
+            // Windows on the street facade, slightly proud of it.
+            const Surface glass = drawSurface(config, "glass", rng);
+            const V2 face = c - side * 0.5 * depth * n - side * 0.03 * n;
+            const V2 t = dir(pp.yaw);
+            for (double fz = 1.0; fz + 1.6 < height; fz += 3.0) {
+              for (double fx = -0.5 * f + 1.0; fx + 1.3 < 0.5 * f; fx += 2.6) {
+                const V2 a = face + fx * t, bq = face + (fx + 1.3) * t;
+                const double zb = z0 + 0.5 + fz;
+                mesh.addQuad(V3f(a.x(), a.y(), zb), V3f(bq.x(), bq.y(), zb), V3f(bq.x(), bq.y(), zb + 1.5),
+                             V3f(a.x(), a.y(), zb + 1.5), glass);
               }
             }
           }
-        }
-        s += f + draw(rng, cc.building_gap);
-      }
-      // Hedges along the sidewalk's outer edge, bushes beyond it, bollards at the curb (their own stream).
-      if (cc.hedge_probability > 0) {
-        for (double s = extra.uniform(0, 10); s < L;) {
-          const double f = draw(extra, cc.building_frontage);
-          if (extra.chance(cc.hedge_probability)) {
-            const double off = W + SW + 0.6, h = draw(extra, cc.hedge_height), depth = extra.uniform(0.7, 1.2);
-            const Surface leaves = drawSurface(config, "foliage", extra);
-            // In pieces of about 2 m, each checked on its own, so a hedge stops at cross roads and driveways.
-            for (double s0 = s; s0 + 0.5 < s + f; s0 += 2.0) {
-              const double s1 = std::min(s0 + 2.0, s + f);
-              const V2 a = road.center.at(s0).p + side * off * normalLeft(road.center.at(s0).yaw);
-              const V2 e = road.center.at(s1).p + side * off * normalLeft(road.center.at(s1).yaw);
-              Box b;
-              b.x = 0.5 * (a.x() + e.x());
-              b.y = 0.5 * (a.y() + e.y());
-              b.length = (e - a).norm();
-              b.width = depth;
-              b.yaw = std::atan2(e.y() - a.y(), e.x() - a.x());
-              if (!nearRoute(V2(b.x, b.y), 5) || !footprintFree(scene, b, 0.0, keep_out)) continue;
-              const double z0 = scene.groundHeight(b.x, b.y);
-              addWall(mesh, a, e, depth, z0 - 0.1, z0 + h, leaves);
+        } else if (rng.chance(cc.wall_probability)) {
+          const double h = draw(rng, cc.wall_height);
+          const V2 a = road.center.at(s).p + side * (W + SW + setback) * normalLeft(road.center.at(s).yaw);
+          const V2 e = road.center.at(s + f).p + side * (W + SW + setback) * normalLeft(road.center.at(s + f).yaw);
+          Box b;
+          b.x = 0.5 * (a.x() + e.x());
+          b.y = 0.5 * (a.y() + e.y());
+          b.length = (e - a).norm();
+          b.width = 0.3;
+          b.yaw = std::atan2(e.y() - a.y(), e.x() - a.x());
+          if (footprintFree(scene, b, 0.2, keep_out)) {
+            const double z0 = scene.groundHeight(b.x, b.y);
+            if (rng.chance(cc.fence_fraction)) {
+              const Surface metal = drawSurface(config, "metal", rng);
+              const int posts = std::max(1, static_cast<int>(b.length / 2.5));
+              for (int k = 0; k <= posts; ++k) {
+                const V2 p = a + (e - a) * (static_cast<double>(k) / posts);
+                mesh.addBeam(V3f(p.x(), p.y(), z0 - 0.2), V3f(p.x(), p.y(), z0 + h), 0.07f, metal);
+              }
+              for (double rz : {0.35 * h, 0.95 * h}) addWall(mesh, a, e, 0.05, z0 + rz - 0.03, z0 + rz + 0.03, metal);
+            } else {
+              addWall(mesh, a, e, 0.25, z0 - 0.3, z0 + h, drawSurface(config, "building", rng));
             }
           }
-          s += f + extra.uniform(1, 6);
         }
       }
-      if (cc.bush_spacing.hi > 0) {
-        for (double s = extra.uniform(0, cc.bush_spacing.hi); s < L; s += std::max(0.5, draw(extra, cc.bush_spacing))) {
-          const PathPose pp = road.center.at(s);
-          const double r = draw(extra, cc.bush_radius);
-          const V2 p = pp.p + side * (W + SW + 0.3 + r + extra.uniform(0, 3)) * normalLeft(pp.yaw);
-          Box fb;
-          fb.x = p.x();
-          fb.y = p.y();
-          fb.length = fb.width = 2 * r;
-          if (!nearRoute(p, 5) || !footprintFree(scene, fb, 0.1, keep_out)) continue;
-          const double z0 = scene.groundHeight(p.x(), p.y());
-          mesh.addEllipsoid(poseAt(p, z0 + 0.6 * r, extra.uniform(0, M_PI)),
-                            V3f(static_cast<float>(r), static_cast<float>(r * extra.uniform(0.6, 1.0)),
-                                static_cast<float>(0.8 * r)),
-                            8, 5, drawSurface(config, "foliage", extra));
+      s += f + draw(rng, cc.building_gap);
+    }
+  }
+
+  // Hedges along the sidewalk's outer edge; hedges, bushes and bollards draw from their own stream (`extra`).
+  void hedges(const Road& road, int side, Rng& extra) {
+    const double L = road.center.length();
+    const double W = road.half_width, SW = road.sidewalk;
+    for (double s = extra.uniform(0, 10); s < L;) {
+      const double f = draw(extra, cc.building_frontage);
+      if (extra.chance(cc.hedge_probability)) {
+        const double off = W + SW + 0.6, h = draw(extra, cc.hedge_height), depth = extra.uniform(0.7, 1.2);
+        const Surface leaves = drawSurface(config, "foliage", extra);
+        // In pieces of about 2 m, each checked on its own, so a hedge stops at cross roads and driveways.
+        for (double s0 = s; s0 + 0.5 < s + f; s0 += 2.0) {
+          const double s1 = std::min(s0 + 2.0, s + f);
+          const V2 a = road.center.at(s0).p + side * off * normalLeft(road.center.at(s0).yaw);
+          const V2 e = road.center.at(s1).p + side * off * normalLeft(road.center.at(s1).yaw);
+          Box b;
+          b.x = 0.5 * (a.x() + e.x());
+          b.y = 0.5 * (a.y() + e.y());
+          b.length = (e - a).norm();
+          b.width = depth;
+          b.yaw = std::atan2(e.y() - a.y(), e.x() - a.x());
+          if (!nearRoute(V2(b.x, b.y), 5) || !footprintFree(scene, b, 0.0, keep_out)) continue;
+          const double z0 = scene.groundHeight(b.x, b.y);
+          addWall(mesh, a, e, depth, z0 - 0.1, z0 + h, leaves);
         }
       }
-      if (cc.bollard_spacing.hi > 0 && SW > 0) {
-        for (double s = extra.uniform(0, cc.bollard_spacing.hi); s < L;
-             s += std::max(0.5, draw(extra, cc.bollard_spacing))) {
-          const PathPose pp = road.center.at(s);
-          const V2 p = pp.p + side * (W + 0.3) * normalLeft(pp.yaw);
-          Box fb;
-          fb.x = p.x();
-          fb.y = p.y();
-          fb.length = fb.width = 0.3;
-          bool at_crossing = false;
-          if (road.main)
-            for (double c : scene.crossings) at_crossing = at_crossing || std::abs(c - s) < 4;
-          if (at_crossing || !nearRoute(p, 5) || scene.onOtherCarriageway(p, static_cast<int>(r), 0.5) ||
-              hitsKeepOut(keep_out, fb))
-            continue;
-          const double z0 = scene.groundHeight(p.x(), p.y()) + rc.curb_height;
-          mesh.addCylinder(poseAt(p, z0 - 0.1, 0), 0.08f, static_cast<float>(0.1 + extra.uniform(0.7, 1.1)), 6,
-                           drawSurface(config, "metal", extra));
-        }
+      s += f + extra.uniform(1, 6);
+    }
+  }
+
+  // Bushes beyond the sidewalk.
+  void bushes(const Road& road, int side, Rng& extra) {
+    const double L = road.center.length();
+    const double W = road.half_width, SW = road.sidewalk;
+    for (double s = extra.uniform(0, cc.bush_spacing.hi); s < L; s += std::max(0.5, draw(extra, cc.bush_spacing))) {
+      const PathPose pp = road.center.at(s);
+      const double r = draw(extra, cc.bush_radius);
+      const V2 p = pp.p + side * (W + SW + 0.3 + r + extra.uniform(0, 3)) * normalLeft(pp.yaw);
+      Box fb;
+      fb.x = p.x();
+      fb.y = p.y();
+      fb.length = fb.width = 2 * r;
+      if (!nearRoute(p, 5) || !footprintFree(scene, fb, 0.1, keep_out)) continue;
+      const double z0 = scene.groundHeight(p.x(), p.y());
+      mesh.addEllipsoid(poseAt(p, z0 + 0.6 * r, extra.uniform(0, M_PI)),
+                        V3f(static_cast<float>(r), static_cast<float>(r * extra.uniform(0.6, 1.0)),
+                            static_cast<float>(0.8 * r)),
+                        8, 5, drawSurface(config, "foliage", extra));
+    }
+  }
+
+  // Bollards at the curb, none near a zebra crossing.
+  void bollards(const Road& road, std::size_t r, int side, Rng& extra) {
+    const double L = road.center.length();
+    const double W = road.half_width;
+    for (double s = extra.uniform(0, cc.bollard_spacing.hi); s < L;
+         s += std::max(0.5, draw(extra, cc.bollard_spacing))) {
+      const PathPose pp = road.center.at(s);
+      const V2 p = pp.p + side * (W + 0.3) * normalLeft(pp.yaw);
+      Box fb;
+      fb.x = p.x();
+      fb.y = p.y();
+      fb.length = fb.width = 0.3;
+      bool at_crossing = false;
+      if (road.main)
+        for (double c : scene.crossings) at_crossing = at_crossing || std::abs(c - s) < 4;
+      if (at_crossing || !nearRoute(p, 5) || scene.onOtherCarriageway(p, static_cast<int>(r), 0.5) ||
+          hitsKeepOut(keep_out, fb))
+        continue;
+      const double z0 = scene.groundHeight(p.x(), p.y()) + rc.curb_height;
+      mesh.addCylinder(poseAt(p, z0 - 0.1, 0), 0.08f, static_cast<float>(0.1 + extra.uniform(0.7, 1.1)), 6,
+                       drawSurface(config, "metal", extra));
+    }
+  }
+
+  // Trees.
+  void trees(const Road& road, std::size_t r, int side) {
+    const double L = road.center.length();
+    const double W = road.half_width, SW = road.sidewalk;
+    for (double s = rng.uniform(0, cc.tree_spacing.hi); s < L; s += draw(rng, cc.tree_spacing)) {
+      const PathPose pp = road.center.at(s);
+      const bool furniture = SW >= 3.0 && cc.vegetation_setback <= 0;
+      const double off = furniture ? W + 0.65 : W + SW + cc.vegetation_setback + rng.uniform(0, 12);
+      const V2 p = pp.p + side * off * normalLeft(pp.yaw);
+      if (!nearRoute(p, 10) || scene.onOtherCarriageway(p, static_cast<int>(r), SW + 1.0)) continue;
+      bool at_crossing = false;
+      if (road.main)
+        for (double c : scene.crossings) at_crossing = at_crossing || std::abs(c - s) < 4;
+      if (at_crossing) continue;
+      Box fb;
+      fb.x = p.x();
+      fb.y = p.y();
+      fb.length = fb.width = 0.8;
+      if (hitsKeepOut(keep_out, fb)) continue;
+      if (!furniture) {
+        int rr = 0;
+        if (scene.roadDistance(p, &rr) < scene.roads[rr].sidewalk + 1.0) continue;
       }
-      // Trees.
-      for (double s = rng.uniform(0, cc.tree_spacing.hi); s < L; s += draw(rng, cc.tree_spacing)) {
+      const double z0 = scene.groundHeight(p.x(), p.y());
+      const double tr = draw(rng, cc.tree_trunk_radius), th = draw(rng, cc.tree_trunk_height);
+      const double cr = draw(rng, cc.tree_crown_radius);
+      mesh.addCylinder(poseAt(p, z0 - 0.2, 0), static_cast<float>(tr), static_cast<float>(th + 0.2 + 0.3 * cr), 7,
+                       drawSurface(config, "bark", rng));
+      mesh.addEllipsoid(poseAt(p, z0 + th + 0.85 * cr, rng.uniform(0, M_PI)),
+                        V3f(static_cast<float>(cr), static_cast<float>(cr * rng.uniform(0.8, 1.0)), static_cast<float>(cr * rng.uniform(0.8, 1.2))),
+                        10, 6, drawSurface(config, "foliage", rng));
+    }
+  }
+
+  // Street lights and signs in the furniture zone (or on the shoulder's edge).
+  void polesAndSigns(const Road& road, std::size_t r, int side) {
+    const double L = road.center.length();
+    const double W = road.half_width, SW = road.sidewalk;
+    for (int kind = 0; kind < 2; ++kind) {
+      const Range spacing = kind == 0 ? cc.pole_spacing : cc.sign_spacing;
+      for (double s = rng.uniform(0, spacing.hi); s < L; s += draw(rng, spacing)) {
         const PathPose pp = road.center.at(s);
-        const bool furniture = SW >= 3.0 && cc.vegetation_setback <= 0;
-        const double off = furniture ? W + 0.65 : W + SW + cc.vegetation_setback + rng.uniform(0, 12);
-        const V2 p = pp.p + side * off * normalLeft(pp.yaw);
-        if (!nearRoute(p, 10) || scene.onOtherCarriageway(p, static_cast<int>(r), SW + 1.0)) continue;
+        const V2 n = normalLeft(pp.yaw);
+        const V2 p = pp.p + side * (W + (SW > 0 ? 0.35 : 1.2)) * n;
+        if (!nearRoute(p, 10) || scene.onOtherCarriageway(p, static_cast<int>(r), SW + 0.5)) continue;
         bool at_crossing = false;
         if (road.main)
-          for (double c : scene.crossings) at_crossing = at_crossing || std::abs(c - s) < 4;
-        if (at_crossing) continue;
+          for (double c : scene.crossings) at_crossing = at_crossing || std::abs(c - s) < 3;
         Box fb;
         fb.x = p.x();
         fb.y = p.y();
-        fb.length = fb.width = 0.8;
-        if (hitsKeepOut(keep_out, fb)) continue;
-        if (!furniture) {
-          int rr = 0;
-          if (scene.roadDistance(p, &rr) < scene.roads[rr].sidewalk + 1.0) continue;
-        }
-        const double z0 = scene.groundHeight(p.x(), p.y());
-        const double tr = draw(rng, cc.tree_trunk_radius), th = draw(rng, cc.tree_trunk_height);
-        const double cr = draw(rng, cc.tree_crown_radius);
-        mesh.addCylinder(poseAt(p, z0 - 0.2, 0), static_cast<float>(tr), static_cast<float>(th + 0.2 + 0.3 * cr), 7,
-                         drawSurface(config, "bark", rng));
-        mesh.addEllipsoid(poseAt(p, z0 + th + 0.85 * cr, rng.uniform(0, M_PI)),
-                          V3f(static_cast<float>(cr), static_cast<float>(cr * rng.uniform(0.8, 1.0)), static_cast<float>(cr * rng.uniform(0.8, 1.2))),
-                          10, 6, drawSurface(config, "foliage", rng));
-      }
-      // Street lights and signs in the furniture zone (or on the shoulder's edge).
-      for (int kind = 0; kind < 2; ++kind) {
-        const Range spacing = kind == 0 ? cc.pole_spacing : cc.sign_spacing;
-        for (double s = rng.uniform(0, spacing.hi); s < L; s += draw(rng, spacing)) {
-          const PathPose pp = road.center.at(s);
-          const V2 n = normalLeft(pp.yaw);
-          const V2 p = pp.p + side * (W + (SW > 0 ? 0.35 : 1.2)) * n;
-          if (!nearRoute(p, 10) || scene.onOtherCarriageway(p, static_cast<int>(r), SW + 0.5)) continue;
-          bool at_crossing = false;
-          if (road.main)
-            for (double c : scene.crossings) at_crossing = at_crossing || std::abs(c - s) < 3;
-          Box fb;
-          fb.x = p.x();
-          fb.y = p.y();
-          fb.length = fb.width = 0.5;
-          if (at_crossing || hitsKeepOut(keep_out, fb)) continue;
-          const double z0 = scene.groundHeight(p.x(), p.y()) + (SW > 0 ? rc.curb_height : 0.0);
-          const Surface metal = drawSurface(config, "metal", rng);
-          if (kind == 0) {
-            const double h = draw(rng, cc.pole_height);
-            mesh.addCylinder(poseAt(p, z0 - 0.2, 0), 0.1f, static_cast<float>(h + 0.2), 6, metal);
-            const V2 arm = p - side * 1.5 * n;
-            mesh.addBeam(V3f(p.x(), p.y(), z0 + h - 0.1), V3f(arm.x(), arm.y(), z0 + h), 0.08f, metal);
-            mesh.addBox(poseAt(arm, z0 + h - 0.1, pp.yaw), V3f(0.5f, 0.3f, 0.15f), metal);
-          } else {
-            mesh.addCylinder(poseAt(p, z0 - 0.2, 0), 0.04f, 2.5f, 5, metal);
-            // Plate facing the traffic of this side.
-            const V2 t = dir(pp.yaw) * (side < 0 ? 1.0 : -1.0);
-            const V2 c = p + 0.06 * t;
-            const V2 q = V2(-t.y(), t.x());
-            const Surface sign = drawSurface(config, "sign", rng);
-            const double zc = z0 + 2.2;
-            mesh.addQuad(V3f(c.x() - 0.3 * q.x(), c.y() - 0.3 * q.y(), zc - 0.3), V3f(c.x() + 0.3 * q.x(), c.y() + 0.3 * q.y(), zc - 0.3),
-                         V3f(c.x() + 0.3 * q.x(), c.y() + 0.3 * q.y(), zc + 0.3), V3f(c.x() - 0.3 * q.x(), c.y() - 0.3 * q.y(), zc + 0.3), sign);
-          }
+        fb.length = fb.width = 0.5;
+        if (at_crossing || hitsKeepOut(keep_out, fb)) continue;
+        const double z0 = scene.groundHeight(p.x(), p.y()) + (SW > 0 ? rc.curb_height : 0.0);
+        const Surface metal = drawSurface(config, "metal", rng);
+        if (kind == 0) {
+          const double h = draw(rng, cc.pole_height);
+          mesh.addCylinder(poseAt(p, z0 - 0.2, 0), 0.1f, static_cast<float>(h + 0.2), 6, metal);
+          const V2 arm = p - side * 1.5 * n;
+          mesh.addBeam(V3f(p.x(), p.y(), z0 + h - 0.1), V3f(arm.x(), arm.y(), z0 + h), 0.08f, metal);
+          mesh.addBox(poseAt(arm, z0 + h - 0.1, pp.yaw), V3f(0.5f, 0.3f, 0.15f), metal);
+        } else {
+          mesh.addCylinder(poseAt(p, z0 - 0.2, 0), 0.04f, 2.5f, 5, metal);
+          // Plate facing the traffic of this side.
+          const V2 t = dir(pp.yaw) * (side < 0 ? 1.0 : -1.0);
+          const V2 c = p + 0.06 * t;
+          const V2 q = V2(-t.y(), t.x());
+          const Surface sign = drawSurface(config, "sign", rng);
+          const double zc = z0 + 2.2;
+          mesh.addQuad(V3f(c.x() - 0.3 * q.x(), c.y() - 0.3 * q.y(), zc - 0.3), V3f(c.x() + 0.3 * q.x(), c.y() + 0.3 * q.y(), zc - 0.3),
+                       V3f(c.x() + 0.3 * q.x(), c.y() + 0.3 * q.y(), zc + 0.3), V3f(c.x() - 0.3 * q.x(), c.y() - 0.3 * q.y(), zc + 0.3), sign);
         }
       }
     }
   }
+
+  Scene& scene;
+  const SimConfig& config;
+  const RoadConfig& rc;
+  const ClutterConfig& cc;
+  Rng& rng;
+  const double view_range;
+  const std::vector<Box>& keep_out;
+  TriangleMesh& mesh;
+  const Road& main;
+  const Path route;
+};
+
+}  // namespace
+
+void buildStaticGeometry(Scene& scene, const SimConfig& config, Rng& rng, double view_range,
+                         const std::vector<Box>& keep_out) {
+  StaticGeometryBuilder(scene, config, rng, view_range, keep_out).build();
 }
 
 }  // namespace sim

@@ -28,7 +28,9 @@
 #include <rosbag/view.h>
 #include <sensor_msgs/PointCloud2.h>
 
+#include "ret3d/core/json_writer.h"
 #include "ret3d/core/log.h"
+#include "ret3d/core/stats.h"
 #include "ret3d/io/kitti.h"
 #include "ret3d/io/sweeps.h"
 #include "ret3d/ros/conversions.h"
@@ -171,25 +173,20 @@ struct Summary {
 
 Summary summarise(std::vector<double> v) {
   Summary s;
-  if (v.empty()) return s;
-  std::sort(v.begin(), v.end());
-  s.median = v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-  s.p95 = v[std::min(v.size() - 1, static_cast<std::size_t>(std::ceil(0.95 * v.size())) - 1)];
+  s.median = median(v);
+  s.p95 = nearestRankPercentile(std::move(v), 95);
   return s;
 }
 
-void printRow(const std::string& name, const Summary& s, std::ostringstream* json, bool* first) {
+void printRow(const std::string& name, const Summary& s, JsonWriter* json) {
   std::cout << std::left << std::setw(26) << name << std::right << std::fixed << std::setprecision(3) << std::setw(12)
             << s.median << std::setw(12) << s.p95 << "\n";
-  *json << (*first ? "" : ", ") << "\"" << name << "\": {\"median_ms\": " << s.median << ", \"p95_ms\": " << s.p95
-        << "}";
-  *first = false;
+  json->beginObject(name).field("median_ms", s.median).field("p95_ms", s.p95).endObject();
 }
 
-void writeJson(const std::string& path, const std::string& text) {
+void writeJson(const std::string& path, const JsonWriter& json) {
   if (path.empty()) return;
-  if (fs::path(path).has_parent_path()) fs::create_directories(fs::path(path).parent_path());
-  std::ofstream(path) << text;
+  json.save(path);
   std::cout << "bench: wrote " << path << "\n";
 }
 
@@ -205,9 +202,7 @@ int benchSynthetic(const BenchArgs& a) {
             << " warm-up and " << a.min_runs << " timed frames per case\n";
   std::cout << std::left << std::setw(26) << "case" << std::right << std::setw(12) << "median ms" << std::setw(12)
             << "p95 ms" << "\n";
-  std::ostringstream json;
-  json << "{";
-  bool first = true;
+  JsonWriter json;
   std::mt19937 rng(1);
   std::uniform_real_distribution<double> speed(-1.0, 1.0);
   const Eigen::Isometry3d I = Eigen::Isometry3d::Identity();
@@ -239,12 +234,11 @@ int benchSynthetic(const BenchArgs& a) {
       }
       const std::string name = std::to_string(n) + (crowded ? "_crowded" : "_spread");
       for (const char* stage : {"intra", "track", "inter", "total"})
-        if (p.times().all().count(stage)) printRow(std::string(stage) + "_" + name, summarise(p.times().all().at(stage)),
-                                                   &json, &first);
+        if (p.times().all().count(stage))
+          printRow(std::string(stage) + "_" + name, summarise(p.times().all().at(stage)), &json);
     }
   }
-  json << "}\n";
-  writeJson(a.json, json.str());
+  writeJson(a.json, json);
   return 0;
 }
 
@@ -412,34 +406,34 @@ int runBench(BenchArgs a) {
   const auto& t = p.times().all();
   std::cout << std::left << std::setw(26) << "stage" << std::right << std::setw(12) << "median ms" << std::setw(12)
             << "p95 ms" << "\n";
-  std::ostringstream json;
-  json << "{";
-  bool first = true;
+  JsonWriter json;
   for (const char* stage : {"bev", "network", "decode", "nms", "refine", "intra", "track", "inter", "total"})
-    if (t.count(stage)) printRow(stage, summarise(t.at(stage)), &json, &first);
+    if (t.count(stage)) printRow(stage, summarise(t.at(stage)), &json);
   const Summary base = summarise(baseTimes(p));
-  printRow("base", base, &json, &first);
+  printRow("base", base, &json);
   std::cout << "(base = bev + network + decode + nms + refine)\n";
   if (baseline) {
     const auto& bt = baseline->times().all();
     for (const char* stage : {"network", "total"})
-      if (bt.count(stage)) printRow(std::string("baseline_") + stage, summarise(bt.at(stage)), &json, &first);
+      if (bt.count(stage)) printRow(std::string("baseline_") + stage, summarise(bt.at(stage)), &json);
     const Summary b = summarise(baseTimes(*baseline));
-    printRow("baseline_base", b, &json, &first);
+    printRow("baseline_base", b, &json);
     std::cout << "bench: new / baseline, interleaved frame by frame: "
               << ratioText("detector (base) median", base.median, b.median) << ", " << ratioText("p95", base.p95, b.p95)
               << "\n";
-    json << ", \"base_ratio_median\": " << (b.median > 0 ? base.median / b.median : 0.0)
-         << ", \"base_ratio_p95\": " << (b.p95 > 0 ? base.p95 / b.p95 : 0.0);
+    json.field("base_ratio_median", b.median > 0 ? base.median / b.median : 0.0)
+        .field("base_ratio_p95", b.p95 > 0 ? base.p95 / b.p95 : 0.0);
   }
   const Detector* det = p.detector();
   const std::string model = det->options().inference.model_path;
   std::cout << "detector: " << det->parameterCount() << " parameters, model file " << fs::file_size(model)
             << " bytes; " << static_cast<double>(boxes) / std::max(1, a.min_runs) << " boxes per frame\n";
-  json << ", \"parameters\": " << det->parameterCount() << ", \"model_bytes\": " << fs::file_size(model)
-       << ", \"frames\": " << frames.size() << ", \"runs\": " << a.min_runs << ", \"threads\": " << a.pipeline.threads
-       << "}\n";
-  writeJson(a.json, json.str());
+  json.field("parameters", det->parameterCount())
+      .field("model_bytes", fs::file_size(model))
+      .field("frames", frames.size())
+      .field("runs", a.min_runs)
+      .field("threads", a.pipeline.threads);
+  writeJson(a.json, json);
   return 0;
 }
 

@@ -17,8 +17,10 @@
 #include <sstream>
 
 #include "ret3d/core/detections.h"
+#include "ret3d/core/json_writer.h"
 #include "ret3d/core/log.h"
 #include "ret3d/core/progress.h"
+#include "ret3d/core/stats.h"
 #include "ret3d/eval/eval_data.h"
 #include "ret3d/eval/velocity_error.h"
 #include "ret3d/io/detections.h"
@@ -57,22 +59,22 @@ std::vector<eval::VelocityFrame> velocityGroundTruth(const kitti::TrackingDatase
 
 void reportVelocity(const std::vector<eval::VelocityFrame>& frames, const std::string& path) {
   const auto stats = eval::velocityErrors(frames);
-  std::ostringstream json;
-  json << "{";
-  bool first = true;
+  JsonWriter json;
   for (const auto& [cls, s] : stats) {
     std::cout << "velocity error " << className(cls) << ": moving objects (> 0.5 m/s) median " << s.moving_median
               << " m/s, p90 " << s.moving_p90 << " m/s over " << s.moving_matched << " matched of " << s.moving_gt
               << "; static median " << s.static_median << " m/s over " << s.static_matched << "\n";
-    json << (first ? "" : ", ") << "\"" << className(cls) << "\": {\"moving_median\": " << s.moving_median
-         << ", \"moving_p90\": " << s.moving_p90 << ", \"moving_matched\": " << s.moving_matched
-         << ", \"moving_gt\": " << s.moving_gt << ", \"static_median\": " << s.static_median
-         << ", \"static_matched\": " << s.static_matched << "}";
-    first = false;
+    json.beginObject(className(cls))
+        .field("moving_median", s.moving_median)
+        .field("moving_p90", s.moving_p90)
+        .field("moving_matched", s.moving_matched)
+        .field("moving_gt", s.moving_gt)
+        .field("static_median", s.static_median)
+        .field("static_matched", s.static_matched)
+        .endObject();
   }
-  json << "}\n";
   if (!path.empty()) {
-    std::ofstream(path) << json.str();
+    json.save(path);
     std::cout << "velocity errors written to " << path << "\n";
   }
 }
@@ -212,12 +214,6 @@ std::size_t detectFromResults(const DetectArgs& a, pipeline::OfflinePipeline* p)
     bar.tick();
   }
   return boxes;
-}
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
 }
 
 int runDetect(DetectArgs a) {

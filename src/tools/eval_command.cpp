@@ -87,6 +87,179 @@ std::size_t attachBagPredictions(EvalData& data, const std::vector<StampedObject
   return matched;
 }
 
+EvalData loadGroundTruthBag(const EvalArgs& a) {
+  EvalData data;
+  for (const auto& m : readBagObjects(a.gt, a.gt_topic)) {
+    EvalFrame f;
+    f.frame = static_cast<int>(data.frames.size());
+    f.stamp = m.stamp;
+    f.gt_boxes = m.boxes;
+    f.gt_ignore.assign(f.gt_boxes.size(), 0);
+    for (const Box& b : m.boxes) {
+      if (b.num_points > 0) data.gt_has_point_counts = true;
+      if (b.track_id > 0) data.gt_has_track_ids = true;
+    }
+    data.frames.push_back(std::move(f));
+  }
+  std::stable_sort(data.frames.begin(), data.frames.end(),
+                   [](const EvalFrame& x, const EvalFrame& y) { return x.stamp < y.stamp; });
+  data.gt_description = a.gt + " (bag, " + a.gt_topic + ")";
+  return data;
+}
+
+// Ground truth, and the predictions when they are a folder (a prediction bag is attached afterwards).
+EvalData loadData(const EvalArgs& a, const std::string& gt_format, bool pred_bag,
+                  const std::vector<std::string>& sequences) {
+  if (gt_format == "bag") {
+    if (!pred_bag) throw std::invalid_argument("--gt is a bag: --pred must be a bag too (topic --pred-topic)");
+    return loadGroundTruthBag(a);
+  }
+  if (gt_format == "tracking") return loadKittiTracking(a.gt, pred_bag ? "" : a.pred, sequences);
+  if (gt_format == "object") {
+    if (pred_bag) throw std::invalid_argument("a prediction bag needs ground truth from a bag or a tracking folder");
+    return loadKittiObject(a.gt, a.pred);
+  }
+  throw std::invalid_argument("--gt-format: auto, object, tracking or bag");
+}
+
+// A tracking folder's single sequence; stamps are START + frame / RATE (as `ret3d convert` writes them).
+std::size_t attachBagPredictionsByFrame(const EvalArgs& a, const std::vector<StampedObjects>& msgs, EvalData& data,
+                                        EvalReport* report) {
+  if (data.calibrations.size() != 1) {
+    throw std::invalid_argument("a prediction bag with a tracking folder needs exactly one --sequences entry");
+  }
+  std::size_t matched = 0;
+  const kitti::Calibration& calib = data.calibrations.begin()->second;
+  for (const auto& m : msgs) {
+    const double f = (m.stamp - a.bag_start_time) * a.bag_rate;
+    const long idx = std::lround(f);
+    if (std::abs(f - idx) * (1.0 / a.bag_rate) > a.stamp_tolerance || idx < 0 ||
+        idx >= static_cast<long>(data.frames.size())) {
+      continue;
+    }
+    EvalFrame& fr = data.frames[idx];
+    fr.pred_boxes.insert(fr.pred_boxes.end(), m.boxes.begin(), m.boxes.end());
+    ++matched;
+  }
+  for (auto& f : data.frames) f.pred_labels = boxesToCameraLabels(f.pred_boxes, calib);
+  report->notes.push_back("Predictions from the bag were placed on frames by stamp = " +
+                          std::to_string(a.bag_start_time) + " + frame / " + std::to_string(a.bag_rate) +
+                          " and converted to camera labels with the sequence's calibration (front camera view).");
+  return matched;
+}
+
+// Bag boxes are converted to camera labels with bag_calib when the ground truth is a bag too.
+void attachPredictionBag(const EvalArgs& a, bool gt_bag, const kitti::Calibration& bag_calib, EvalData& data,
+                         EvalReport* report) {
+  const auto msgs = readBagObjects(a.pred, a.pred_topic);
+  std::size_t matched = 0;
+  if (gt_bag) {
+    matched = attachBagPredictions(data, msgs, a.stamp_tolerance);
+    for (auto& f : data.frames) fillLabelsFromBoxes(f, bag_calib);
+    report->notes.push_back("Bag boxes (LiDAR frame) were converted to KITTI camera labels with " +
+                            (a.calib.empty() ? std::string("the default KITTI calibration")
+                                             : "the calibration " + a.calib) +
+                            " and kept only in the front camera's view (in front of the camera, projected 2D box "
+                            "overlapping the 1242x375 image). Bag ground truth has no truncation or occlusion, so "
+                            "KITTI difficulty follows the 2D box height alone.");
+  } else {
+    matched = attachBagPredictionsByFrame(a, msgs, data, report);
+  }
+  for (const auto& f : data.frames) {
+    for (const Box& b : f.pred_boxes) {
+      if (b.track_id > 0) data.pred_has_track_ids = true;
+    }
+  }
+  data.pred_description = a.pred + " (bag, " + a.pred_topic + ", " + std::to_string(msgs.size()) + " messages, " +
+                          std::to_string(matched) + " matched to ground-truth frames)";
+  if (matched < msgs.size()) {
+    RET3D_WARN(msgs.size() - matched << " prediction messages match no ground-truth frame by stamp");
+  }
+}
+
+MotSimilarity parseSimilarity(const std::string& name) {
+  for (const MotSimilarity s : {MotSimilarity::Iou3d, MotSimilarity::IouBev, MotSimilarity::CenterDistance})
+    if (name == similarityName(s)) return s;
+  throw std::invalid_argument("--mot-similarity: iou3d, bev or center");
+}
+
+// Not inlined: inlined into runEval, GCC 12 warns (falsely) that MotOptions' default class list may be uninitialized.
+[[gnu::noinline]] MotOptions motOptions(const EvalArgs& a, const std::vector<ObjectClass>& classes) {
+  MotOptions o;
+  o.classes = classes;
+  o.threads = a.threads;
+  o.threshold = a.mot_threshold;
+  o.zero_distance = a.mot_zero_distance;
+  o.max_range = a.mot_max_range;
+  o.similarity = parseSimilarity(a.mot_similarity);
+  return o;
+}
+
+// The metrics' results; EvalReport points into them.
+struct EvalResults {
+  KittiResult kitti_strict, kitti_loose;
+  WaymoResult waymo;
+  MotResult mot;
+  IdStabilityResult id_stability;
+};
+
+void evalKitti(const EvalArgs& a, const std::vector<ObjectClass>& classes, const EvalData& data, EvalResults* res,
+               EvalReport* report) {
+  std::vector<KittiFrame> frames;
+  frames.reserve(data.frames.size());
+  for (const auto& f : data.frames) frames.push_back({f.gt_labels, f.pred_labels});
+  KittiApOptions o;
+  o.classes = classes;
+  o.exact_recall = a.kitti_recall == "exact";
+  o.threads = a.threads;
+  std::optional<ProgressBar> bar;
+  o.progress = stageBar(bar, "KITTI AP");
+  res->kitti_strict = evaluateKitti(frames, o);
+  std::optional<ProgressBar> bar_loose;
+  o.progress = stageBar(bar_loose, "KITTI AP (loose)");
+  o.min_overlap = kKittiLooseOverlap;
+  res->kitti_loose = evaluateKitti(frames, o);
+  report->kitti = &res->kitti_strict;
+  report->kitti_loose = &res->kitti_loose;
+}
+
+void evalWaymo(const EvalArgs& a, const std::vector<ObjectClass>& classes, EvalData& data, EvalResults* res,
+               EvalReport* report) {
+  if (!data.gt_has_point_counts) {
+    std::optional<ProgressBar> bar;
+    const std::size_t counted = countGroundTruthPoints(data, a.threads, stageBar(bar, "points in boxes"));
+    if (counted > 0) report->notes.push_back("Waymo levels: points counted in each ground-truth box from the scans.");
+  }
+  WaymoOptions o;
+  o.classes = classes;
+  o.threads = a.threads;
+  o.use_point_counts = data.gt_has_point_counts;
+  std::optional<ProgressBar> bar;
+  o.progress = stageBar(bar, "Waymo AP");
+  res->waymo = evaluateWaymo(data.frames, o);
+  report->waymo = &res->waymo;
+  report->waymo_options = o;
+  report->waymo_options.progress = nullptr;
+}
+
+void evalMot(const EvalArgs& a, const std::vector<ObjectClass>& classes, const EvalData& data, EvalResults* res,
+             EvalReport* report) {
+  if (!data.gt_has_track_ids || !data.pred_has_track_ids) {
+    const std::string why = !data.gt_has_track_ids ? "the ground truth has no track ids"
+                                                    : "the predictions have no track ids";
+    RET3D_WARN("tracking metrics skipped: " << why);
+    report->notes.push_back("Tracking metrics skipped: " + why + ".");
+    return;
+  }
+  const MotOptions o = motOptions(a, classes);
+  res->mot = evaluateMot(data.frames, o);
+  report->mot = &res->mot;
+  report->mot_options = o;
+  report->id_stability_options.classes = classes;
+  res->id_stability = evaluateIdStability(data.frames, report->id_stability_options);
+  report->id_stability = &res->id_stability;
+}
+
 int runEval(const EvalArgs& a) {
   const auto t_start = std::chrono::steady_clock::now();
   std::set<std::string> metrics;
@@ -106,78 +279,8 @@ int runEval(const EvalArgs& a) {
   const kitti::Calibration bag_calib = a.calib.empty() ? kitti::defaultCalibration() : kitti::readCalibration(a.calib);
 
   EvalReport report;
-  EvalData data;
-  if (gt_format == "bag") {
-    if (!pred_bag) throw std::invalid_argument("--gt is a bag: --pred must be a bag too (topic --pred-topic)");
-    for (const auto& m : readBagObjects(a.gt, a.gt_topic)) {
-      EvalFrame f;
-      f.frame = static_cast<int>(data.frames.size());
-      f.stamp = m.stamp;
-      f.gt_boxes = m.boxes;
-      f.gt_ignore.assign(f.gt_boxes.size(), 0);
-      for (const Box& b : m.boxes) {
-        if (b.num_points > 0) data.gt_has_point_counts = true;
-        if (b.track_id > 0) data.gt_has_track_ids = true;
-      }
-      data.frames.push_back(std::move(f));
-    }
-    std::stable_sort(data.frames.begin(), data.frames.end(),
-                     [](const EvalFrame& x, const EvalFrame& y) { return x.stamp < y.stamp; });
-    data.gt_description = a.gt + " (bag, " + a.gt_topic + ")";
-  } else if (gt_format == "tracking") {
-    data = loadKittiTracking(a.gt, pred_bag ? "" : a.pred, sequences);
-  } else if (gt_format == "object") {
-    if (pred_bag) throw std::invalid_argument("a prediction bag needs ground truth from a bag or a tracking folder");
-    data = loadKittiObject(a.gt, a.pred);
-  } else {
-    throw std::invalid_argument("--gt-format: auto, object, tracking or bag");
-  }
-
-  if (pred_bag) {
-    const auto msgs = readBagObjects(a.pred, a.pred_topic);
-    std::size_t matched = 0;
-    if (gt_format == "bag") {
-      matched = attachBagPredictions(data, msgs, a.stamp_tolerance);
-      for (auto& f : data.frames) fillLabelsFromBoxes(f, bag_calib);
-      report.notes.push_back("Bag boxes (LiDAR frame) were converted to KITTI camera labels with " +
-                             (a.calib.empty() ? std::string("the default KITTI calibration")
-                                              : "the calibration " + a.calib) +
-                             " and kept only in the front camera's view (in front of the camera, projected 2D box "
-                             "overlapping the 1242x375 image). Bag ground truth has no truncation or occlusion, so "
-                             "KITTI difficulty follows the 2D box height alone.");
-    } else {
-      // A tracking folder's single sequence; stamps are START + frame / RATE (as `ret3d convert` writes them).
-      if (data.calibrations.size() != 1) {
-        throw std::invalid_argument("a prediction bag with a tracking folder needs exactly one --sequences entry");
-      }
-      const kitti::Calibration& calib = data.calibrations.begin()->second;
-      for (const auto& m : msgs) {
-        const double f = (m.stamp - a.bag_start_time) * a.bag_rate;
-        const long idx = std::lround(f);
-        if (std::abs(f - idx) * (1.0 / a.bag_rate) > a.stamp_tolerance || idx < 0 ||
-            idx >= static_cast<long>(data.frames.size())) {
-          continue;
-        }
-        EvalFrame& fr = data.frames[idx];
-        fr.pred_boxes.insert(fr.pred_boxes.end(), m.boxes.begin(), m.boxes.end());
-        ++matched;
-      }
-      for (auto& f : data.frames) f.pred_labels = boxesToCameraLabels(f.pred_boxes, calib);
-      report.notes.push_back("Predictions from the bag were placed on frames by stamp = " +
-                             std::to_string(a.bag_start_time) + " + frame / " + std::to_string(a.bag_rate) +
-                             " and converted to camera labels with the sequence's calibration (front camera view).");
-    }
-    for (const auto& f : data.frames) {
-      for (const Box& b : f.pred_boxes) {
-        if (b.track_id > 0) data.pred_has_track_ids = true;
-      }
-    }
-    data.pred_description = a.pred + " (bag, " + a.pred_topic + ", " + std::to_string(msgs.size()) + " messages, " +
-                            std::to_string(matched) + " matched to ground-truth frames)";
-    if (matched < msgs.size()) {
-      RET3D_WARN(msgs.size() - matched << " prediction messages match no ground-truth frame by stamp");
-    }
-  }
+  EvalData data = loadData(a, gt_format, pred_bag, sequences);
+  if (pred_bag) attachPredictionBag(a, gt_format == "bag", bag_calib, data, &report);
 
   report.gt_source = data.gt_description;
   report.pred_source = data.pred_description;
@@ -189,75 +292,10 @@ int runEval(const EvalArgs& a) {
   if (data.frames.empty()) throw std::runtime_error("no frames to evaluate");
 
   const auto t_eval = std::chrono::steady_clock::now();
-  KittiResult kitti_strict, kitti_loose;
-  if (metrics.count("kitti")) {
-    std::vector<KittiFrame> frames;
-    frames.reserve(data.frames.size());
-    for (const auto& f : data.frames) frames.push_back({f.gt_labels, f.pred_labels});
-    KittiApOptions o;
-    o.classes = classes;
-    o.exact_recall = a.kitti_recall == "exact";
-    o.threads = a.threads;
-    std::optional<ProgressBar> bar;
-    o.progress = stageBar(bar, "KITTI AP");
-    kitti_strict = evaluateKitti(frames, o);
-    std::optional<ProgressBar> bar_loose;
-    o.progress = stageBar(bar_loose, "KITTI AP (loose)");
-    o.min_overlap = kKittiLooseOverlap;
-    kitti_loose = evaluateKitti(frames, o);
-    report.kitti = &kitti_strict;
-    report.kitti_loose = &kitti_loose;
-  }
-  WaymoResult waymo;
-  if (metrics.count("waymo")) {
-    if (!data.gt_has_point_counts) {
-      std::optional<ProgressBar> bar;
-      const std::size_t counted = countGroundTruthPoints(data, a.threads, stageBar(bar, "points in boxes"));
-      if (counted > 0) report.notes.push_back("Waymo levels: points counted in each ground-truth box from the scans.");
-    }
-    WaymoOptions o;
-    o.classes = classes;
-    o.threads = a.threads;
-    o.use_point_counts = data.gt_has_point_counts;
-    std::optional<ProgressBar> bar;
-    o.progress = stageBar(bar, "Waymo AP");
-    waymo = evaluateWaymo(data.frames, o);
-    report.waymo = &waymo;
-    report.waymo_options = o;
-    report.waymo_options.progress = nullptr;
-  }
-  MotResult mot;
-  IdStabilityResult id_stability;
-  if (metrics.count("mot")) {
-    if (!data.gt_has_track_ids || !data.pred_has_track_ids) {
-      const std::string why = !data.gt_has_track_ids ? "the ground truth has no track ids"
-                                                      : "the predictions have no track ids";
-      RET3D_WARN("tracking metrics skipped: " << why);
-      report.notes.push_back("Tracking metrics skipped: " + why + ".");
-    } else {
-      MotOptions o;
-      o.classes = classes;
-      o.threads = a.threads;
-      o.threshold = a.mot_threshold;
-      o.zero_distance = a.mot_zero_distance;
-      o.max_range = a.mot_max_range;
-      if (a.mot_similarity == "iou3d") {
-        o.similarity = MotSimilarity::Iou3d;
-      } else if (a.mot_similarity == "bev") {
-        o.similarity = MotSimilarity::IouBev;
-      } else if (a.mot_similarity == "center") {
-        o.similarity = MotSimilarity::CenterDistance;
-      } else {
-        throw std::invalid_argument("--mot-similarity: iou3d, bev or center");
-      }
-      mot = evaluateMot(data.frames, o);
-      report.mot = &mot;
-      report.mot_options = o;
-      report.id_stability_options.classes = classes;
-      id_stability = evaluateIdStability(data.frames, report.id_stability_options);
-      report.id_stability = &id_stability;
-    }
-  }
+  EvalResults results;
+  if (metrics.count("kitti")) evalKitti(a, classes, data, &results, &report);
+  if (metrics.count("waymo")) evalWaymo(a, classes, data, &results, &report);
+  if (metrics.count("mot")) evalMot(a, classes, data, &results, &report);
   const auto t_end = std::chrono::steady_clock::now();
   report.seconds = std::chrono::duration<double>(t_end - t_eval).count();
   const auto pngs = writeReport(a.out, report);

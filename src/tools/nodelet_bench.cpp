@@ -39,6 +39,8 @@
 
 #include "ret3d/DetectionArray.h"
 #include "ret3d/Object3DArray.h"
+#include "ret3d/core/json_writer.h"
+#include "ret3d/core/stats.h"
 #include "ret3d/ros/diagnostics.h"
 #include "ret3d/ros/params.h"
 
@@ -708,11 +710,16 @@ void reportSoak(const std::vector<SoakWindow>& windows, const NodeletBenchOption
   }
 
   if (o.json.empty()) return;
-  if (fs::path(o.json).has_parent_path()) fs::create_directories(fs::path(o.json).parent_path());
-  std::ostringstream json, table;
-  json << std::fixed << std::setprecision(3) << "{\"frames\": " << frames << ", \"every\": " << every
-       << ", \"rate_hz\": " << rate_hz << ", \"load\": " << o.load << ", \"warmup\": " << o.warmup
-       << ", \"measured\": " << measured << ", \"answered\": " << answered << ", \"samples\": [";
+  JsonWriter json({/*decimals=*/3});
+  json.field("frames", frames)
+      .field("every", every)
+      .field("rate_hz", rate_hz)
+      .field("load", o.load)
+      .field("warmup", o.warmup)
+      .field("measured", measured)
+      .field("answered", answered)
+      .beginArray("samples");
+  std::ostringstream table;
   table << "# frame\twall_s\trss_mb\tfds\tthreads\tcpu_cores\te2e_p50_ms\te2e_p95_ms\te2e_max_ms\tdetector_p50_ms\t"
            "detector_p95_ms\tanswered\tmeasured\tmachine_load\n"
         << std::fixed << std::setprecision(3);
@@ -720,16 +727,23 @@ void reportSoak(const std::vector<SoakWindow>& windows, const NodeletBenchOption
     const SoakWindow& w = windows[i];
     const double max = w.end_to_end_ms.empty() ? 0.0 : *std::max_element(w.end_to_end_ms.begin(), w.end_to_end_ms.end());
     const double t = w.process.wall_s - windows.front().process.wall_s;
-    json << (i ? ", " : "") << "{\"frame\": " << w.frame << ", \"wall_s\": " << t << ", \"rss_mb\": "
-         << w.process.rss_mb << ", \"fds\": " << w.process.fds << ", \"threads\": " << w.process.threads
-         << ", \"machine_load\": " << w.process.machine_load;
+    json.beginObject()
+        .field("frame", w.frame)
+        .field("wall_s", t)
+        .field("rss_mb", w.process.rss_mb)
+        .field("fds", w.process.fds)
+        .field("threads", w.process.threads)
+        .field("machine_load", w.process.machine_load);
     if (w.frame > 0)
-      json << ", \"cpu_cores\": " << w.cpu_cores << ", \"end_to_end_p50_ms\": " << percentile(w.end_to_end_ms, 50)
-           << ", \"end_to_end_p95_ms\": " << percentile(w.end_to_end_ms, 95) << ", \"end_to_end_max_ms\": " << max
-           << ", \"detector_p50_ms\": " << percentile(w.base_ms, 50)
-           << ", \"detector_p95_ms\": " << percentile(w.base_ms, 95) << ", \"answered\": " << w.answered
-           << ", \"measured\": " << w.measured;
-    json << "}";
+      json.field("cpu_cores", w.cpu_cores)
+          .field("end_to_end_p50_ms", percentile(w.end_to_end_ms, 50))
+          .field("end_to_end_p95_ms", percentile(w.end_to_end_ms, 95))
+          .field("end_to_end_max_ms", max)
+          .field("detector_p50_ms", percentile(w.base_ms, 50))
+          .field("detector_p95_ms", percentile(w.base_ms, 95))
+          .field("answered", w.answered)
+          .field("measured", w.measured);
+    json.endObject();
     if (w.frame > 0)
       table << w.frame << "\t" << t << "\t" << w.process.rss_mb << "\t" << w.process.fds << "\t" << w.process.threads
             << "\t" << w.cpu_cores << "\t" << percentile(w.end_to_end_ms, 50) << "\t"
@@ -737,22 +751,303 @@ void reportSoak(const std::vector<SoakWindow>& windows, const NodeletBenchOption
             << percentile(w.base_ms, 95) << "\t" << w.answered << "\t" << w.measured << "\t"
             << w.process.machine_load << "\n";
   }
-  json << "]";
+  json.endArray();
   if (checks)
-    json << ", \"checks\": {\"reference_frame\": " << k << ", \"rss_reference_mb\": " << ref->process.rss_mb
-         << ", \"rss_end_mb\": " << end.process.rss_mb << ", \"rss_growth_percent\": " << rss_growth
-         << ", \"fds_reference\": " << ref->process.fds << ", \"fds_end\": " << end.process.fds
-         << ", \"p95_first_ms\": " << p95_first << ", \"p95_last_ms\": " << p95_last
-         << ", \"p95_change_percent\": " << p95_change << ", \"rss_ok\": " << (rss_ok ? "true" : "false")
-         << ", \"fds_ok\": " << (fds_ok ? "true" : "false") << ", \"p95_ok\": " << (p95_ok ? "true" : "false")
-         << ", \"passed\": " << (rss_ok && fds_ok && p95_ok ? "true" : "false") << "}";
-  json << "}\n";
-  std::ofstream(o.json) << json.str();
+    json.beginObject("checks")
+        .field("reference_frame", k)
+        .field("rss_reference_mb", ref->process.rss_mb)
+        .field("rss_end_mb", end.process.rss_mb)
+        .field("rss_growth_percent", rss_growth)
+        .field("fds_reference", ref->process.fds)
+        .field("fds_end", end.process.fds)
+        .field("p95_first_ms", p95_first)
+        .field("p95_last_ms", p95_last)
+        .field("p95_change_percent", p95_change)
+        .field("rss_ok", rss_ok)
+        .field("fds_ok", fds_ok)
+        .field("p95_ok", p95_ok)
+        .field("passed", rss_ok && fds_ok && p95_ok)
+        .endObject();
+  json.save(o.json);
   const std::string tsv = fs::path(o.json).replace_extension(".tsv").string();
   std::ofstream(tsv) << table.str();
   std::cout << "bench: wrote " << o.json << " and " << tsv << "\n";
 }
 
+
+void checkOptions(const NodeletBenchOptions& o) {
+  if (o.stages.empty() || o.stages.front() != "base")
+    throw std::runtime_error("--stages must start with base: the nodelets are fed point clouds");
+  if (o.rate <= 0) throw std::runtime_error("--rate must be > 0, not " + std::to_string(o.rate));
+  if (o.loop_frames < 0) throw std::runtime_error("--loop-frames must be >= 0, not " + std::to_string(o.loop_frames));
+  if (o.soak_every <= 0) throw std::runtime_error("--soak-every must be > 0, not " + std::to_string(o.soak_every));
+  if (o.load < 0) throw std::runtime_error("--load must be >= 0, not " + std::to_string(o.load));
+}
+
+bool hasStage(const std::vector<Stage>& stages, const std::string& name) {
+  return std::any_of(stages.begin(), stages.end(), [&](const Stage& s) { return s.name == name; });
+}
+
+// The nodelets of --stages in pipeline order; InterRM brings the tracker it reads from.
+std::vector<Stage> pipelineStages(const NodeletBenchOptions& o) {
+  auto has = [&](const char* s) { return std::find(o.stages.begin(), o.stages.end(), s) != o.stages.end(); };
+  const bool intra = has("intra"), inter = has("inter"), tracker = has("track") || inter;
+  std::vector<Stage> stages = {{"base", "ret3d_detector", "ret3d/DetectorNodelet", kPoints, "/detections"}};
+  if (intra) stages.push_back({"intra", "ret3d_intra", "ret3d/IntraRMNodelet", "/detections", "/detections_intra"});
+  if (tracker)
+    stages.push_back({"track", "ret3d_tracker", "ret3d/TrackerNodelet", stages.back().output, "/tracked"});
+  if (inter) stages.push_back({"inter", "ret3d_inter", "ret3d/InterRMNodelet", "/tracked", "/objects"});
+  return stages;
+}
+
+// The write end of the pipe that starts the player.
+struct PipeEnd {
+  int fd;
+  ~PipeEnd() { close(fd); }
+};
+
+// Forks the bag player; it starts playing when a byte arrives on *go_fd. Call before this process starts any ROS
+// thread.
+pid_t forkPlayer(const NodeletBenchOptions& o, const BagPlan& plan, int* go_fd) {
+  int go[2];
+  if (pipe(go) != 0) throw std::runtime_error(std::string("pipe: ") + std::strerror(errno));
+  std::cout.flush();
+  std::cerr.flush();
+  const pid_t player_pid = fork();
+  if (player_pid < 0) throw std::runtime_error(std::string("fork: ") + std::strerror(errno));
+  if (player_pid == 0) {
+    prctl(PR_SET_PDEATHSIG, SIGTERM);  // a killed bench takes its player along
+    close(go[1]);
+    int rc = 1;
+    try {
+      rc = playBag(o, plan, go[0]);
+    } catch (const std::exception& e) {
+      std::cerr << "bench player: " << e.what() << std::endl;
+    }
+    _exit(rc);
+  }
+  close(go[0]);
+  *go_fd = go[1];
+  return player_pid;
+}
+
+// The nodelets' parameters: the package's YAML, then what the options override.
+void setNodeletParams(const NodeletBenchOptions& o, const std::string& params) {
+  loadParams(params);
+  ros::param::set("/ret3d_detector/model_path", o.detector_model);
+  ros::param::set("/ret3d_detector/config", o.detector_config);
+  ros::param::set("/ret3d_detector/threads", o.threads);
+  if (o.score_threshold >= 0) ros::param::set("/ret3d_detector/score_threshold", o.score_threshold);
+  if (!o.grid_extent.empty()) ros::param::set("/ret3d_detector/grid_extent", o.grid_extent);
+  ros::param::set("/ret3d_intra/model_path", o.intra_model);
+  ros::param::set("/ret3d_intra/threads", o.threads);
+  if (!o.tracker_config.empty()) ros::param::set("/ret3d_tracker/tracker_config", o.tracker_config);
+  ros::param::set("/ret3d_inter/model_path", o.inter_model);
+  ros::param::set("/ret3d_inter/threads", o.threads);
+  ros::param::set("/ret3d_inter/passthrough", false);
+}
+
+void loadNodelets(nodelet::Loader& loader, const std::vector<Stage>& stages, const NodeletBenchOptions& o) {
+  const bool intra = hasStage(stages, "intra"), inter = hasStage(stages, "inter");
+  std::cout << "bench: loading the nodelets into this process (the manager, " << o.manager_threads
+            << " callback threads):";
+  std::vector<std::pair<std::string, std::string>> load;
+  for (const Stage& s : stages) load.emplace_back(s.nodelet, s.type);
+  const bool markers = o.markers && inter;
+  if (markers) load.emplace_back("ret3d_markers", "ret3d/MarkerNodelet");
+  for (const auto& [name, type] : load) std::cout << " " << type;
+  std::cout << std::endl;
+  for (const auto& [name, type] : load) {
+    ros::M_string remap;
+    // Without IntraRM the tracker reads the detector's output, as launch/ret3d.launch remaps it with intra:=false.
+    if (name == "ret3d_tracker" && !intra) remap["/detections_intra"] = "/detections";
+    if (!loader.load("/" + name, type, remap, {}))
+      throw std::runtime_error("nodelet " + name + " (" + type + ") did not start; see the message above");
+  }
+}
+
+// Starts the player and waits until it has ended and the pipeline has answered (or --tail has passed); a soak
+// samples this process meanwhile.
+void playAndWait(const NodeletBenchOptions& o, const BagPlan& plan, ChildProcess& player, int go_fd,
+                 Recorder& recorder, std::optional<Soak>& soak_log) {
+  const bool soak = soak_log.has_value();
+  std::cout << "bench: playing " << plan.clouds << " clouds of " << o.bag << " " << plan.topic << " at "
+            << std::setprecision(1) << std::fixed << plan.cloud_rate_hz * o.rate << " Hz"
+            << (o.rate != 1.0 ? " (--rate " + std::to_string(o.rate) + ")" : "") << " on " << kPoints
+            << " from a player process, stamps moved to now" << (plan.tf ? ", with /tf" : ", no /tf in the bag")
+            << (plan.tf_static ? " and /tf_static" : "") << "; " << o.warmup << " warm-up frames left out\n"
+            << std::flush;
+  if (soak)
+    std::cout << "bench: soak: the bag looped for " << o.loop_frames << " clouds; this process (pid " << getpid()
+              << ") sampled every " << o.soak_every << " clouds" << std::endl;
+  // The other work starts with the replay, after the nodelets have loaded and warmed up.
+  std::optional<BusyLoad> busy;
+  if (o.load > 0) {
+    busy.emplace(o.load);
+    std::cout << "bench: " << o.load << " busy process" << (o.load > 1 ? "es" : "") << " spinning (--load) during "
+              << "the replay" << std::endl;
+  }
+  if (soak) soak_log->begin();
+  if (write(go_fd, "g", 1) != 1) throw std::runtime_error("the player process is gone");
+  const double played_s = (soak ? static_cast<double>(o.loop_frames) / std::max(1e-9, plan.cloud_rate_hz)
+                                : plan.duration) / o.rate;
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(played_s + 30.0 + o.tail);
+  ros::WallTime played;
+  bool player_done = false;
+  while (ros::ok()) {
+    const ros::WallTime now = ros::WallTime::now();
+    if (!player_done && player.ended()) {
+      player_done = true;
+      played = now;
+      if (player.exitCode() != 0)
+        throw std::runtime_error("the player process failed (exit code " + std::to_string(player.exitCode()) +
+                                 "); see its message above");
+      if (soak) soak_log->end();
+    }
+    if (soak) {
+      soak_log->poll();
+      if (player_done && soak_log->idle()) break;
+    } else if (player_done) {
+      const auto [in, out] = recorder.progress();
+      if (in == out || (now - played).toSec() > o.tail) break;
+    }
+    if (now > deadline) {
+      std::cout << "bench: the run took longer than the bag (+30 s); stopping\n";
+      break;
+    }
+    ros::WallDuration(0.02).sleep();
+  }
+  if (!ros::ok()) throw std::runtime_error("interrupted");
+}
+
+// What a run measured: per-cloud times of the input, each stage and end to end, after the warm-up.
+struct Measurement {
+  explicit Measurement(const std::string& last_output) : end_to_end{"end_to_end", "  stamp to " + last_output} {}
+  Row input{"input", "  stamp to cloud in the manager (player, transport)"};
+  std::vector<Row> rows;
+  Row end_to_end;
+  std::size_t frames = 0, frames_out = 0;
+  Recorder::Cpu cpu;
+  double player_cpu = 0;
+  std::vector<SoakWindow> soak_windows;
+};
+
+void tabulate(const Recorder& recorder, const DiagnosticsRecorder& diagnostics, const std::vector<Stage>& stages,
+              Measurement* m) {
+  const auto measured = recorder.measured();
+  m->frames = measured.size();
+  for (std::size_t k = 0; k < stages.size(); ++k) {
+    m->rows.emplace_back(stages[k].name,
+                         "  " + stages[k].input + " to " + stages[k].output + " (" + stages[k].type + ")");
+    m->rows.back().processing_p50 = diagnostics.value(stages[k].nodelet, "processing p50 (ms)");
+    m->rows.back().processing_p95 = diagnostics.value(stages[k].nodelet, "processing p95 (ms)");
+  }
+  for (const auto& [stamp, at] : measured) {
+    m->input.ms.push_back(1e3 * (at[0] - stamp));
+    for (std::size_t k = 0; k < stages.size(); ++k) {
+      m->rows[k].in += std::isnan(at[k]) ? 0 : 1;
+      if (!std::isnan(at[k]) && !std::isnan(at[k + 1])) m->rows[k].ms.push_back(1e3 * (at[k + 1] - at[k]));
+      m->rows[k].out += std::isnan(at[k + 1]) ? 0 : 1;
+    }
+    if (!std::isnan(at.back())) {
+      m->end_to_end.ms.push_back(1e3 * (at.back() - stamp));
+      ++m->frames_out;
+    }
+  }
+  m->input.in = m->input.out = m->frames;
+  m->end_to_end.in = m->frames, m->end_to_end.out = m->frames_out;
+  m->cpu = recorder.cpu();
+}
+
+// Loads the nodelets into this process, plays the bag through them and records every stage's outputs.
+Measurement measure(const NodeletBenchOptions& o, const std::vector<Stage>& stages, const BagPlan& plan,
+                    const std::string& params, ChildProcess& player, int go_fd) {
+  Measurement m(stages.back().output);
+  ros::NodeHandle nh, private_nh("~");
+  setNodeletParams(o, params);
+  private_nh.setParam("num_worker_threads", o.manager_threads);
+  nodelet::Loader loader(private_nh);
+  loadNodelets(loader, stages, o);
+
+  Recorder recorder(stages.size() + 1, static_cast<std::size_t>(std::max(0, o.warmup)));
+  std::vector<ros::Subscriber> subscribers;
+  subscribers.push_back(record<sensor_msgs::PointCloud2>(nh, kPoints, 0, &recorder));
+  for (std::size_t k = 0; k < stages.size(); ++k) {
+    if (stages[k].output == "/objects")
+      subscribers.push_back(record<ret3d::Object3DArray>(nh, stages[k].output, k + 1, &recorder));
+    else
+      subscribers.push_back(record<ret3d::DetectionArray>(nh, stages[k].output, k + 1, &recorder));
+  }
+  DiagnosticsRecorder diagnostics;
+  subscribers.push_back(nh.subscribe("/diagnostics", 100, &DiagnosticsRecorder::onMessage, &diagnostics));
+  ros::AsyncSpinner spinner(2);
+  spinner.start();
+  const bool soak = o.loop_frames > 0;
+  std::optional<Soak> soak_log;
+  if (soak) soak_log.emplace(&recorder, static_cast<std::size_t>(o.soak_every), std::max(2.0, o.tail));
+  playAndWait(o, plan, player, go_fd, recorder, soak_log);
+  // The nodelets report once a second: one more report of each covers the last frames.
+  std::vector<std::string> nodelets;
+  for (const Stage& s : stages) nodelets.push_back(s.nodelet);
+  const double ended = ros::WallTime::now().toSec();
+  for (int i = 0; i < 150 && ros::ok() && !soak && !diagnostics.reportedSince(nodelets, ended); ++i)
+    ros::WallDuration(0.01).sleep();
+  if (soak) m.soak_windows = soak_log->windows();
+  spinner.stop();
+  subscribers.clear();
+  loader.clear();
+  m.player_cpu = player.cpuSeconds();
+  tabulate(recorder, diagnostics, stages, &m);
+  return m;
+}
+
+void printTable(const Measurement& m, const std::vector<Stage>& stages, unsigned cores) {
+  const std::size_t dropped = m.frames - m.frames_out;
+  std::cout << std::left << std::setw(12) << "stage" << std::right << std::setw(10) << "p50 ms" << std::setw(10)
+            << "p95 ms" << std::setw(13) << "out/in" << std::setw(16) << "processing ms" << "\n";
+  printRow(m.input, m.frames);
+  for (const Row& r : m.rows) printRow(r, m.frames);
+  printRow(m.end_to_end, m.frames);
+  std::cout << "(p50 / p95 per cloud after the warm-up: from the arrival of a stage's input to that of its output, "
+               "waiting included; processing p50 / p95: the stage's own /diagnostics over its last 200 frames)\n";
+  std::cout << std::setprecision(1) << "frames: " << m.frames << " measured, " << m.frames_out << " with "
+            << stages.back().output << ", " << dropped << " dropped ("
+            << 100.0 * static_cast<double>(dropped) / std::max<std::size_t>(1, m.frames) << " %)\n"
+            << std::setprecision(2) << "CPU: " << m.cpu.cores << " cores of " << cores << " (" << std::setprecision(0)
+            << 100.0 * m.cpu.cores / cores << " %) used by the manager process over the " << std::setprecision(1)
+            << m.cpu.seconds << " s measured; the player used " << m.player_cpu << " s of CPU in all\n"
+            << "machine: " << m.cpu.steal_percent
+            << " % of CPU time stolen by the hypervisor meanwhile (/proc/stat steal; above a few percent the timings "
+               "say more about the host than about the pipeline)\n";
+}
+
+void writeBenchJson(const NodeletBenchOptions& o, const BagPlan& plan, const Measurement& m, unsigned cores) {
+  JsonWriter json({/*decimals=*/3});
+  auto add = [&](const Row& r) {
+    json.beginObject(r.name)
+        .field("median_ms", percentile(r.ms, 50))
+        .field("p95_ms", percentile(r.ms, 95))
+        .field("frames_out", r.out);
+    if (r.processing_p50 >= 0)
+      json.field("processing_median_ms", r.processing_p50).field("processing_p95_ms", r.processing_p95);
+    json.endObject();
+  };
+  add(m.input);
+  for (const Row& r : m.rows) add(r);
+  add(m.end_to_end);
+  json.field("frames", m.frames)
+      .field("frames_out", m.frames_out)
+      .field("dropped", m.frames - m.frames_out)
+      .field("warmup", o.warmup)
+      .field("input_rate_hz", plan.cloud_rate_hz * o.rate)
+      .field("cpu_cores", m.cpu.cores)
+      .field("cpu_percent", 100.0 * m.cpu.cores / cores)
+      .field("steal_percent", m.cpu.steal_percent)
+      .field("cores", cores)
+      .field("threads", o.threads);
+  json.save(o.json);
+  std::cout << "bench: wrote " << o.json << "\n";
+}
 
 }  // namespace
 
@@ -783,20 +1078,8 @@ BusyLoad::~BusyLoad() {
 }
 
 int runNodeletBench(const NodeletBenchOptions& o, NodeletBenchResult* result) {
-  if (o.stages.empty() || o.stages.front() != "base")
-    throw std::runtime_error("--stages must start with base: the nodelets are fed point clouds");
-  if (o.rate <= 0) throw std::runtime_error("--rate must be > 0, not " + std::to_string(o.rate));
-  if (o.loop_frames < 0) throw std::runtime_error("--loop-frames must be >= 0, not " + std::to_string(o.loop_frames));
-  if (o.soak_every <= 0) throw std::runtime_error("--soak-every must be > 0, not " + std::to_string(o.soak_every));
-  if (o.load < 0) throw std::runtime_error("--load must be >= 0, not " + std::to_string(o.load));
-  const bool soak = o.loop_frames > 0;
-  auto has = [&](const char* s) { return std::find(o.stages.begin(), o.stages.end(), s) != o.stages.end(); };
-  const bool intra = has("intra"), inter = has("inter"), tracker = has("track") || inter;
-  std::vector<Stage> stages = {{"base", "ret3d_detector", "ret3d/DetectorNodelet", kPoints, "/detections"}};
-  if (intra) stages.push_back({"intra", "ret3d_intra", "ret3d/IntraRMNodelet", "/detections", "/detections_intra"});
-  if (tracker)
-    stages.push_back({"track", "ret3d_tracker", "ret3d/TrackerNodelet", stages.back().output, "/tracked"});
-  if (inter) stages.push_back({"inter", "ret3d_inter", "ret3d/InterRMNodelet", "/tracked", "/objects"});
+  checkOptions(o);
+  const std::vector<Stage> stages = pipelineStages(o);
   const std::string params = o.params.empty() ? packagePath() + "/config/ret3d.yaml" : o.params;
   if (packagePath().empty() && (o.params.empty() || o.tracker_config.empty()))
     throw std::runtime_error("the ret3d package is not on ROS_PACKAGE_PATH (`source scripts/env.sh`), so its "
@@ -815,30 +1098,9 @@ int runNodeletBench(const NodeletBenchOptions& o, NodeletBenchResult* result) {
   setenv("ROS_MASTER_URI", master_uri.c_str(), 1);
   std::cout << "bench: private ROS master at " << master_uri << " (rosmaster --core, stopped at the end)\n";
 
-  // The player is forked before this process starts any ROS thread.
-  int go[2];
-  if (pipe(go) != 0) throw std::runtime_error(std::string("pipe: ") + std::strerror(errno));
-  std::cout.flush();
-  std::cerr.flush();
-  const pid_t player_pid = fork();
-  if (player_pid < 0) throw std::runtime_error(std::string("fork: ") + std::strerror(errno));
-  if (player_pid == 0) {
-    prctl(PR_SET_PDEATHSIG, SIGTERM);  // a killed bench takes its player along
-    close(go[1]);
-    int rc = 1;
-    try {
-      rc = playBag(o, plan, go[0]);
-    } catch (const std::exception& e) {
-      std::cerr << "bench player: " << e.what() << std::endl;
-    }
-    _exit(rc);
-  }
-  close(go[0]);
-  ChildProcess player(player_pid);
-  struct Fd {
-    int fd;
-    ~Fd() { close(fd); }
-  } go_fd{go[1]};
+  int go_write = -1;
+  ChildProcess player(forkPlayer(o, plan, &go_write));
+  const PipeEnd go_fd{go_write};
 
   ros::M_string no_remappings;
   ros::init(no_remappings, "ret3d_bench");
@@ -846,200 +1108,25 @@ int runNodeletBench(const NodeletBenchOptions& o, NodeletBenchResult* result) {
   // The nodelets' INFO lines (listening on ..., warmed up) would bury the table; warnings and errors still show.
   if (ros::console::set_logger_level("ros", ros::console::levels::Warn)) ros::console::notifyLoggerLevelsChanged();
 
-  Row input{"input", "  stamp to cloud in the manager (player, transport)"};
-  std::vector<Row> rows;
-  Row end_to_end{"end_to_end", "  stamp to " + stages.back().output};
-  std::size_t frames = 0, frames_out = 0;
-  Recorder::Cpu cpu;
-  double player_cpu = 0;
-  std::vector<SoakWindow> soak_windows;
-  {
-    ros::NodeHandle nh, private_nh("~");
-    loadParams(params);
-    ros::param::set("/ret3d_detector/model_path", o.detector_model);
-    ros::param::set("/ret3d_detector/config", o.detector_config);
-    ros::param::set("/ret3d_detector/threads", o.threads);
-    if (o.score_threshold >= 0) ros::param::set("/ret3d_detector/score_threshold", o.score_threshold);
-    if (!o.grid_extent.empty()) ros::param::set("/ret3d_detector/grid_extent", o.grid_extent);
-    ros::param::set("/ret3d_intra/model_path", o.intra_model);
-    ros::param::set("/ret3d_intra/threads", o.threads);
-    if (!o.tracker_config.empty()) ros::param::set("/ret3d_tracker/tracker_config", o.tracker_config);
-    ros::param::set("/ret3d_inter/model_path", o.inter_model);
-    ros::param::set("/ret3d_inter/threads", o.threads);
-    ros::param::set("/ret3d_inter/passthrough", false);
-    private_nh.setParam("num_worker_threads", o.manager_threads);
-
-    std::cout << "bench: loading the nodelets into this process (the manager, " << o.manager_threads
-              << " callback threads):";
-    nodelet::Loader loader(private_nh);
-    std::vector<std::pair<std::string, std::string>> load;
-    for (const Stage& s : stages) load.emplace_back(s.nodelet, s.type);
-    const bool markers = o.markers && inter;
-    if (markers) load.emplace_back("ret3d_markers", "ret3d/MarkerNodelet");
-    for (const auto& [name, type] : load) std::cout << " " << type;
-    std::cout << std::endl;
-    for (const auto& [name, type] : load) {
-      ros::M_string remap;
-      // Without IntraRM the tracker reads the detector's output, as launch/ret3d.launch remaps it with intra:=false.
-      if (name == "ret3d_tracker" && !intra) remap["/detections_intra"] = "/detections";
-      if (!loader.load("/" + name, type, remap, {}))
-        throw std::runtime_error("nodelet " + name + " (" + type + ") did not start; see the message above");
-    }
-
-    Recorder recorder(stages.size() + 1, static_cast<std::size_t>(std::max(0, o.warmup)));
-    std::vector<ros::Subscriber> subscribers;
-    subscribers.push_back(record<sensor_msgs::PointCloud2>(nh, kPoints, 0, &recorder));
-    for (std::size_t k = 0; k < stages.size(); ++k) {
-      if (stages[k].output == "/objects")
-        subscribers.push_back(record<ret3d::Object3DArray>(nh, stages[k].output, k + 1, &recorder));
-      else
-        subscribers.push_back(record<ret3d::DetectionArray>(nh, stages[k].output, k + 1, &recorder));
-    }
-    DiagnosticsRecorder diagnostics;
-    subscribers.push_back(nh.subscribe("/diagnostics", 100, &DiagnosticsRecorder::onMessage, &diagnostics));
-    ros::AsyncSpinner spinner(2);
-    spinner.start();
-    std::optional<Soak> soak_log;
-    if (soak) soak_log.emplace(&recorder, static_cast<std::size_t>(o.soak_every), std::max(2.0, o.tail));
-
-    std::cout << "bench: playing " << plan.clouds << " clouds of " << o.bag << " " << plan.topic << " at "
-              << std::setprecision(1) << std::fixed << plan.cloud_rate_hz * o.rate << " Hz"
-              << (o.rate != 1.0 ? " (--rate " + std::to_string(o.rate) + ")" : "") << " on " << kPoints
-              << " from a player process, stamps moved to now" << (plan.tf ? ", with /tf" : ", no /tf in the bag")
-              << (plan.tf_static ? " and /tf_static" : "") << "; " << o.warmup << " warm-up frames left out\n"
-              << std::flush;
-    if (soak)
-      std::cout << "bench: soak: the bag looped for " << o.loop_frames << " clouds; this process (pid " << getpid()
-                << ") sampled every " << o.soak_every << " clouds" << std::endl;
-    // The other work starts with the replay, after the nodelets have loaded and warmed up.
-    std::optional<BusyLoad> busy;
-    if (o.load > 0) {
-      busy.emplace(o.load);
-      std::cout << "bench: " << o.load << " busy process" << (o.load > 1 ? "es" : "") << " spinning (--load) during "
-                << "the replay" << std::endl;
-    }
-    if (soak) soak_log->begin();
-    if (write(go_fd.fd, "g", 1) != 1) throw std::runtime_error("the player process is gone");
-    const double played_s = (soak ? static_cast<double>(o.loop_frames) / std::max(1e-9, plan.cloud_rate_hz)
-                                  : plan.duration) / o.rate;
-    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(played_s + 30.0 + o.tail);
-    ros::WallTime played;
-    bool player_done = false;
-    while (ros::ok()) {
-      const ros::WallTime now = ros::WallTime::now();
-      if (!player_done && player.ended()) {
-        player_done = true;
-        played = now;
-        if (player.exitCode() != 0)
-          throw std::runtime_error("the player process failed (exit code " + std::to_string(player.exitCode()) +
-                                   "); see its message above");
-        if (soak) soak_log->end();
-      }
-      if (soak) {
-        soak_log->poll();
-        if (player_done && soak_log->idle()) break;
-      } else if (player_done) {
-        const auto [in, out] = recorder.progress();
-        if (in == out || (now - played).toSec() > o.tail) break;
-      }
-      if (now > deadline) {
-        std::cout << "bench: the run took longer than the bag (+30 s); stopping\n";
-        break;
-      }
-      ros::WallDuration(0.02).sleep();
-    }
-    if (!ros::ok()) throw std::runtime_error("interrupted");
-    busy.reset();
-    // The nodelets report once a second: one more report of each covers the last frames.
-    std::vector<std::string> nodelets;
-    for (const Stage& s : stages) nodelets.push_back(s.nodelet);
-    const double ended = ros::WallTime::now().toSec();
-    for (int i = 0; i < 150 && ros::ok() && !soak && !diagnostics.reportedSince(nodelets, ended); ++i)
-      ros::WallDuration(0.01).sleep();
-    if (soak) soak_windows = soak_log->windows();
-    spinner.stop();
-    subscribers.clear();
-    loader.clear();
-    player_cpu = player.cpuSeconds();
-
-    const auto measured = recorder.measured();
-    frames = measured.size();
-    for (std::size_t k = 0; k < stages.size(); ++k) {
-      rows.emplace_back(stages[k].name, "  " + stages[k].input + " to " + stages[k].output + " (" + stages[k].type + ")");
-      rows.back().processing_p50 = diagnostics.value(stages[k].nodelet, "processing p50 (ms)");
-      rows.back().processing_p95 = diagnostics.value(stages[k].nodelet, "processing p95 (ms)");
-    }
-    for (const auto& [stamp, at] : measured) {
-      input.ms.push_back(1e3 * (at[0] - stamp));
-      for (std::size_t k = 0; k < stages.size(); ++k) {
-        rows[k].in += std::isnan(at[k]) ? 0 : 1;
-        if (!std::isnan(at[k]) && !std::isnan(at[k + 1])) rows[k].ms.push_back(1e3 * (at[k + 1] - at[k]));
-        rows[k].out += std::isnan(at[k + 1]) ? 0 : 1;
-      }
-      if (!std::isnan(at.back())) {
-        end_to_end.ms.push_back(1e3 * (at.back() - stamp));
-        ++frames_out;
-      }
-    }
-    input.in = input.out = frames;
-    end_to_end.in = frames, end_to_end.out = frames_out;
-    cpu = recorder.cpu();
-  }
+  const Measurement m = measure(o, stages, plan, params, player, go_fd.fd);
   ros::shutdown();
   master.stop(SIGINT);
-  if (soak) {
-    reportSoak(soak_windows, o, plan.cloud_rate_hz * o.rate, stages.back().output);
+  if (o.loop_frames > 0) {
+    reportSoak(m.soak_windows, o, plan.cloud_rate_hz * o.rate, stages.back().output);
     return 0;
   }
 
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
-  const std::size_t dropped = frames - frames_out;
   if (result) {
-    result->base_p50 = percentile(rows.front().ms, 50), result->base_p95 = percentile(rows.front().ms, 95);
-    result->base_processing_p50 = rows.front().processing_p50;
-    result->base_processing_p95 = rows.front().processing_p95;
-    result->end_to_end_p50 = percentile(end_to_end.ms, 50), result->end_to_end_p95 = percentile(end_to_end.ms, 95);
-    result->frames = frames, result->dropped = dropped;
+    result->base_p50 = percentile(m.rows.front().ms, 50), result->base_p95 = percentile(m.rows.front().ms, 95);
+    result->base_processing_p50 = m.rows.front().processing_p50;
+    result->base_processing_p95 = m.rows.front().processing_p95;
+    result->end_to_end_p50 = percentile(m.end_to_end.ms, 50);
+    result->end_to_end_p95 = percentile(m.end_to_end.ms, 95);
+    result->frames = m.frames, result->dropped = m.frames - m.frames_out;
   }
-  std::cout << std::left << std::setw(12) << "stage" << std::right << std::setw(10) << "p50 ms" << std::setw(10)
-            << "p95 ms" << std::setw(13) << "out/in" << std::setw(16) << "processing ms" << "\n";
-  printRow(input, frames);
-  for (const Row& r : rows) printRow(r, frames);
-  printRow(end_to_end, frames);
-  std::cout << "(p50 / p95 per cloud after the warm-up: from the arrival of a stage's input to that of its output, "
-               "waiting included; processing p50 / p95: the stage's own /diagnostics over its last 200 frames)\n";
-  std::cout << std::setprecision(1) << "frames: " << frames << " measured, " << frames_out << " with "
-            << stages.back().output << ", " << dropped << " dropped (" << 100.0 * static_cast<double>(dropped) / std::max<std::size_t>(1, frames)
-            << " %)\n"
-            << std::setprecision(2) << "CPU: " << cpu.cores << " cores of " << cores << " (" << std::setprecision(0)
-            << 100.0 * cpu.cores / cores << " %) used by the manager process over the " << std::setprecision(1)
-            << cpu.seconds << " s measured; the player used " << player_cpu << " s of CPU in all\n"
-            << "machine: " << cpu.steal_percent
-            << " % of CPU time stolen by the hypervisor meanwhile (/proc/stat steal; above a few percent the timings "
-               "say more about the host than about the pipeline)\n";
-
-  if (!o.json.empty()) {
-    std::ostringstream json;
-    json << std::fixed << std::setprecision(3) << "{";
-    auto add = [&](const Row& r) {
-      json << "\"" << r.name << "\": {\"median_ms\": " << percentile(r.ms, 50) << ", \"p95_ms\": " << percentile(r.ms, 95)
-           << ", \"frames_out\": " << r.out;
-      if (r.processing_p50 >= 0)
-        json << ", \"processing_median_ms\": " << r.processing_p50 << ", \"processing_p95_ms\": " << r.processing_p95;
-      json << "}, ";
-    };
-    add(input);
-    for (const Row& r : rows) add(r);
-    add(end_to_end);
-    json << "\"frames\": " << frames << ", \"frames_out\": " << frames_out << ", \"dropped\": " << dropped
-         << ", \"warmup\": " << o.warmup << ", \"input_rate_hz\": " << plan.cloud_rate_hz * o.rate
-         << ", \"cpu_cores\": " << cpu.cores << ", \"cpu_percent\": " << 100.0 * cpu.cores / cores
-         << ", \"steal_percent\": " << cpu.steal_percent
-         << ", \"cores\": " << cores << ", \"threads\": " << o.threads << "}\n";
-    if (fs::path(o.json).has_parent_path()) fs::create_directories(fs::path(o.json).parent_path());
-    std::ofstream(o.json) << json.str();
-    std::cout << "bench: wrote " << o.json << "\n";
-  }
+  printTable(m, stages, cores);
+  if (!o.json.empty()) writeBenchJson(o, plan, m, cores);
   return 0;
 }
 

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "ret3d/core/progress.h"
+#include "ret3d/core/stats.h"
 #include "ret3d/ros/kitti_bag.h"
 #include "ret3d/sim/realism.h"
 #include "ret3d/sim/simulator.h"
@@ -141,11 +142,6 @@ int runSim(const SimArgs& args) {
     double s = 0;
     for (double x : v) s += x;
     return v.empty() ? 0.0 : s / v.size();
-  };
-  auto median = [](std::vector<double> v) {
-    if (v.empty()) return 0.0;
-    std::sort(v.begin(), v.end());
-    return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
   };
   double total_time = 0;
   for (double t : times) total_time += t;

@@ -22,9 +22,6 @@
 
 namespace ret3d {
 
-// Linear-interpolated percentile (p in [0, 100]) of the values; 0 for none.
-double percentile(std::vector<double> values, double p);
-
 // Why a frame got no output. Every reason is always reported (0 when it never happened).
 enum class DropReason {
   Superseded,  // a newer message arrived while this one waited for the worker (latest-frame policy)

@@ -91,6 +91,18 @@ class Traffic {
   Eigen::Isometry3d egoPose() const;
 
  private:
+  // spawn() in parts; they draw from rng in this order: the ego, then lane by lane its parked cars, moving cars,
+  // cyclists or pedestrians. Actors far from the ego's `route` are not drawn.
+  void spawnEgo(Rng& rng);
+  void spawnParked(const Lane& l, const Path& route, double view_range, Rng& rng);
+  void spawnCars(const Lane& l, Rng& rng);
+  void spawnCyclists(const Lane& l, const Path& route, double view_range, Rng& rng);
+  void spawnPedestrians(const Lane& l, const Path& route, double view_range, Rng& rng);
+  void planRightTurn(Actor& a, const Lane& l) const;  // at the next intersection ahead, when a lane leads right
+  void planCrossing(Actor& a, const Lane& l) const;   // across the main road at the next zebra crossing ahead
+  bool nearCrossing(const Eigen::Vector2d& p, double d) const;  // within d (m, along the main road) of a zebra crossing
+  // Places a and adds it unless it overlaps static geometry, another actor or the ego.
+  void tryAdd(Actor a);
   void place(Actor& a);  // pose from path and station
   void advance(Actor& a, double t, double dt, Rng& rng);
   double leaderGap(const Actor& a, double horizon, double* leader_speed) const;
