@@ -32,11 +32,12 @@ simulate_once "$DATA" config/sim/urban_street.yaml 12 80 3000
 
 NAMES=()
 for n in $HISTORIES; do
-  sed "s/^\(  max_history:\) *[0-9]*/\1 $n/" config/relation/inter_lwd3d.yaml >"$OUT/configs/inter_h$n.yaml"
+  # The shipped config with another history length (a `base:` path absolute, as the file lives under $OUT).
+  printf 'base: %s\nmodel:\n  max_history: %s\n' "$PWD/config/relation/inter_lwd3d.yaml" "$n" >"$OUT/configs/inter_h$n.yaml"
   NAMES+=("inter_h$n")
 done
 for pe in $PES; do
-  cp "config/relation/inter_lwd3d_pe_$pe.yaml" "$OUT/configs/inter_pe_$pe.yaml"
+  printf 'base: %s\n' "$PWD/config/relation/inter_lwd3d_pe_$pe.yaml" >"$OUT/configs/inter_pe_$pe.yaml"
   NAMES+=("inter_pe_$pe")
 done
 

@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <vector>
 
 #include <yaml-cpp/yaml.h>
 
@@ -11,12 +12,6 @@ namespace {
 
 [[noreturn]] void refuse(const std::string& origin, const std::string& key, const std::string& reason) {
   throw ConfigError(key.empty() ? origin + ": " + reason : origin + ": key '" + key + "': " + reason);
-}
-
-std::string number(double v) {
-  std::ostringstream os;
-  os << v;
-  return os.str();
 }
 
 std::string lineOf(const YAML::Node& n) { return "line " + std::to_string(n.Mark().line + 1); }
@@ -89,13 +84,81 @@ const char* const kClassList = "Car, Pedestrian, Cyclist";
 
 }  // namespace
 
-std::string readConfigText(const std::string& file, const std::string& origin) {
+namespace {
+
+std::string readWholeFile(const std::string& file, const std::string& origin) {
   std::ifstream in(file);
   std::error_code ec;
   if (!in || std::filesystem::is_directory(file, ec)) throw ConfigError(origin + ": cannot be read");
   std::stringstream ss;
   ss << in.rdbuf();
   return ss.str();
+}
+
+// `over` laid over `base`: maps key by key (recursively), anything else (a number, a list) replaced whole.
+YAML::Node merged(const YAML::Node& base, const YAML::Node& over) {
+  if (!base.IsMap() || !over.IsMap()) return YAML::Clone(over);
+  YAML::Node out = YAML::Clone(base);
+  for (const auto& kv : over) {
+    const std::string key = kv.first.Scalar();
+    YAML::Node existing;
+    for (const auto& b : out)
+      if (b.first.IsScalar() && b.first.Scalar() == key) existing.reset(b.second);
+    out[key] = existing.IsDefined() ? merged(existing, kv.second) : YAML::Clone(kv.second);
+  }
+  return out;
+}
+
+// The document of `file` with its `base:` chain resolved; `chain` holds the files that include it (cycle check).
+// Returns an undefined node when the file has no `base:` (its text is then used as it is, line numbers intact).
+YAML::Node resolveBase(const std::string& file, const std::string& origin, std::vector<std::string>* chain) {
+  const std::string text = readWholeFile(file, origin);
+  YAML::Node doc;
+  try {
+    doc = YAML::Load(text);
+  } catch (const YAML::Exception&) {
+    if (chain->empty()) return YAML::Node(YAML::NodeType::Undefined);  // parse() reports it, with its line
+    throw ConfigError(origin + ": included as a base by " + chain->back() + ": not valid YAML");
+  }
+  const YAML::Node& const_doc = doc;  // the const operator[] looks a key up without adding it
+  if (!doc.IsMap() || !const_doc["base"]) return chain->empty() ? YAML::Node(YAML::NodeType::Undefined) : doc;
+  const YAML::Node base_key = const_doc["base"];
+  if (!base_key.IsScalar() || base_key.Scalar().empty())
+    refuse(origin, "base", "expected the path of a base file (relative to this file), not " + shown(base_key) + " (" +
+                               lineOf(base_key) + ")");
+  std::filesystem::path base_path(base_key.Scalar());
+  if (base_path.is_relative()) base_path = std::filesystem::path(file).parent_path() / base_path;
+  const std::string base_file = base_path.lexically_normal().string();
+  std::error_code ec;
+  const std::string canonical = std::filesystem::weakly_canonical(file, ec).string();
+  chain->push_back(canonical.empty() ? file : canonical);
+  const std::string base_canonical = std::filesystem::weakly_canonical(base_file, ec).string();
+  for (const std::string& f : *chain) {
+    if (f != base_canonical) continue;
+    std::string cycle;
+    for (const std::string& g : *chain) cycle += g + " -> ";
+    refuse(origin, "base", "the bases form a cycle: " + cycle + base_canonical);
+  }
+  if (!std::filesystem::exists(base_file, ec))
+    refuse(origin, "base", "the base file '" + base_file + "' does not exist (" + lineOf(base_key) + ")");
+  YAML::Node base = resolveBase(base_file, base_file, chain);
+  chain->pop_back();
+  if (!base.IsNull() && !base.IsMap())
+    throw ConfigError(base_file + ": a base file must hold a map (included by " + file + ")");
+  YAML::Node over = YAML::Clone(doc);
+  over.remove("base");
+  return base.IsNull() ? over : merged(base, over);
+}
+
+}  // namespace
+
+std::string readConfigText(const std::string& file, const std::string& origin) {
+  std::vector<std::string> chain;
+  const YAML::Node resolved = resolveBase(file, origin, &chain);
+  if (!resolved.IsDefined()) return readWholeFile(file, origin);
+  YAML::Emitter e;
+  e << resolved;
+  return std::string(e.c_str()) + "\n";
 }
 
 YamlReader::YamlReader(const YAML::Node& node, std::string origin, std::string path)
@@ -253,12 +316,8 @@ void YamlReader::finish() const {
   }
 }
 
-void YamlReader::within(const std::string& key, double v, double lo, double hi) const {
-  if (v >= lo && v <= hi) return;
-  const std::string bound = hi == kNoLimit   ? "must be >= " + number(lo)
-                            : lo == -kNoLimit ? "must be <= " + number(hi)
-                                              : "must lie in [" + number(lo) + ", " + number(hi) + "]";
-  fail(key, bound + ", got " + number(v));
+void YamlReader::within(const std::string& key, double v, const OptionRange& range) const {
+  if (!range.contains(v)) fail(key, range.describe() + ", got " + optionValueText(v));
 }
 
 }  // namespace ret3d

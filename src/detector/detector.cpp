@@ -24,8 +24,7 @@ struct Detector::Impl {
 };
 
 Detector::Detector(const DetectorOptions& options) : options_(options), impl_(std::make_unique<Impl>()) {
-  options_.model.validate();
-  options_.validateGridExtent();
+  options_.validate();
   torch::set_num_threads(options_.inference.threads);
   if (options_.inference.model_path.empty()) {
     impl_->model = std::make_shared<nn::DetectorModel>(options_.model);
@@ -40,7 +39,7 @@ Detector::Detector(const DetectorOptions& options, std::shared_ptr<nn::DetectorM
     : options_(options), impl_(std::make_unique<Impl>()) {
   const auto diffs = diffModelConfigs(model->config(), options_.model);
   if (!diffs.empty()) throw std::invalid_argument("Detector: the model does not match the options: " + diffs.front());
-  options_.validateGridExtent();
+  options_.validate();
   impl_->model = std::move(model);
   impl_->encoder = std::make_unique<BevEncoder>(options_.bevOptions());
 }
@@ -104,11 +103,11 @@ Detections Detector::detect(const PointCloud& current, const PointCloud* previou
 }
 
 void Detector::setThresholds(double score_threshold, double nms_iou) {
-  if (!(score_threshold >= 0 && score_threshold <= 1) || !(nms_iou >= 0 && nms_iou <= 1))
-    throw std::invalid_argument("detector thresholds must lie in [0, 1]: score_threshold " +
-                                std::to_string(score_threshold) + ", nms_iou " + std::to_string(nms_iou));
-  options_.inference.score_threshold = score_threshold;
-  options_.inference.nms_iou = nms_iou;
+  InferenceOptions next = options_.inference;
+  next.score_threshold = static_cast<float>(score_threshold);
+  next.nms_iou = nms_iou;
+  next.validate();
+  options_.inference = next;
 }
 
 }  // namespace ret3d

@@ -1,6 +1,7 @@
 #include "ret3d/detector/detector_options.h"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <stdexcept>
 
@@ -56,15 +57,55 @@ void ModelConfig::validate() const {
   if (!(sweep_interval > 0)) fail("sweep_interval must be positive");
 }
 
-BevGeometry DetectorOptions::inferenceGeometry() const {
-  BevGeometry g = model.geometry;
-  if (inference.grid_extent.size() == 4) {
-    g.x_min = inference.grid_extent[0];
-    g.x_max = inference.grid_extent[1];
-    g.y_min = inference.grid_extent[2];
-    g.y_max = inference.grid_extent[3];
-  }
+GridExtent GridExtent::fromValues(const std::vector<double>& v) {
+  std::string shown = "[";
+  for (std::size_t i = 0; i < v.size(); ++i) shown += (i ? ", " : "") + optionValueText(v[i]);
+  shown += "]";
+  if (v.size() != 4)
+    throw OptionError("grid_extent", shown, "expected [x_min, x_max, y_min, y_max], 4 numbers, not " +
+                                                std::to_string(v.size()));
+  for (double x : v)
+    if (!std::isfinite(x)) throw OptionError("grid_extent", shown, "must be finite numbers");
+  const GridExtent e{v[0], v[1], v[2], v[3]};
+  if (!(e.x_max > e.x_min)) throw OptionError("grid_extent", shown, "x_max must exceed x_min");
+  if (!(e.y_max > e.y_min)) throw OptionError("grid_extent", shown, "y_max must exceed y_min");
+  return e;
+}
+
+std::string GridExtent::describe() const {
+  return "[" + optionValueText(x_min) + ", " + optionValueText(x_max) + ", " + optionValueText(y_min) + ", " +
+         optionValueText(y_max) + "]";
+}
+
+BevGeometry GridExtent::appliedTo(BevGeometry g) const {
+  g.x_min = x_min;
+  g.x_max = x_max;
+  g.y_min = y_min;
+  g.y_max = y_max;
   return g;
+}
+
+BevGeometry DetectorOptions::inferenceGeometry() const {
+  return inference.grid_extent ? inference.grid_extent->appliedTo(model.geometry) : model.geometry;
+}
+
+void InferenceOptions::validate() const {
+  checkOption("threads", threads, kThreads);
+  checkOption("score_threshold", score_threshold, kScoreThreshold);
+  checkOption("candidate_threshold", candidate_threshold, kCandidateThreshold);
+  checkOption("max_candidates", max_candidates, kMaxCandidates);
+  checkOption("max_detections", max_detections, kMaxDetections);
+  checkOption("nms_iou", nms_iou, kNmsIou);
+  checkOption("nms_voting_iou", nms_voting_iou, kNmsVotingIou);
+  checkOption("iou_score_power", iou_score_power, kIouScorePower);
+  for (const auto& [c, speed] : heading_from_velocity)
+    checkOption(std::string("heading_from_velocity.") + className(c), speed, kHeadingSpeed);
+  if (grid_extent) GridExtent::fromValues(grid_extent->values());
+  try {
+    point_refine.validate();
+  } catch (const std::invalid_argument& e) {
+    throw OptionError("point_refine", "", e.what());
+  }
 }
 
 float InferenceOptions::candidateThreshold(ObjectClass c) const {
@@ -73,12 +114,21 @@ float InferenceOptions::candidateThreshold(ObjectClass c) const {
   return score_threshold;
 }
 
-void DetectorOptions::validateGridExtent() const {
-  if (inference.grid_extent.empty()) return;
-  if (inference.grid_extent.size() != 4) throw std::invalid_argument("expected [x_min, x_max, y_min, y_max]");
+void DetectorOptions::validate() const {
+  model.validate();
+  try {
+    inference.validate();
+  } catch (const OptionError& e) {
+    throw e.under("inference");
+  }
+  if (!inference.grid_extent) return;
   ModelConfig m = model;
   m.geometry = inferenceGeometry();
-  m.validate();
+  try {
+    m.validate();
+  } catch (const std::invalid_argument& e) {
+    throw OptionError("inference.grid_extent", inference.grid_extent->describe(), e.what());
+  }
 }
 
 BevEncoderOptions DetectorOptions::bevOptions() const {
@@ -150,17 +200,22 @@ void readModel(YamlReader r, ModelConfig* m) {
 void readInference(YamlReader r, InferenceOptions* o) {
   r.get("model_path", &o->model_path);
   r.get("threads", &o->threads);
-  r.get("score_threshold", &o->score_threshold, 0, 1);
-  r.get("candidate_threshold", &o->candidate_threshold, 0, 1);
+  r.get("score_threshold", &o->score_threshold);
+  r.get("candidate_threshold", &o->candidate_threshold);
   r.get("max_candidates", &o->max_candidates);
   r.get("max_detections", &o->max_detections);
   r.get("nms_iou", &o->nms_iou);
   r.get("nms_voting_iou", &o->nms_voting_iou);
   r.get("iou_score_power", &o->iou_score_power);
   readClassValues(r, "heading_from_velocity", &o->heading_from_velocity);
-  for (const auto& [c, speed] : o->heading_from_velocity)
-    r.within(std::string("heading_from_velocity.") + className(c), speed, 0, YamlReader::kNoLimit);  // m/s
-  r.get("grid_extent", &o->grid_extent);  // checked against the model once it is read (detectorOptionsFromYaml)
+  std::vector<double> extent;
+  if (r.get("grid_extent", &extent)) {  // checked against the model once it is read (DetectorOptions::validate)
+    try {
+      o->grid_extent = GridExtent::fromValues(extent);
+    } catch (const OptionError& e) {
+      r.fail(e.key(), e.reason() + ", got " + e.value());
+    }
+  }
   {
     YamlReader p = r.child("point_refine");
     p.getClasses("faces", &o->point_refine.faces);
@@ -183,16 +238,13 @@ void readInference(YamlReader r, InferenceOptions* o) {
     p.get("heading_min_points", &o->point_refine.heading_min_points);
     readClassValues(p, "score_calibration", &o->point_refine.score_calibration);
     p.finish();
-    try {
-      o->point_refine.validate();
-    } catch (const std::invalid_argument& e) {
-      r.fail("point_refine", e.what());
-    }
   }
   r.finish();
-  r.within("iou_score_power", o->iou_score_power, 0, 1);
-  r.within("nms_voting_iou", o->nms_voting_iou, 0, 1);
-  r.within("threads", o->threads, 1, YamlReader::kNoLimit);
+  try {
+    o->validate();
+  } catch (const OptionError& e) {
+    r.fail(e.key(), e.value().empty() ? e.reason() : e.reason() + ", got " + e.value());
+  }
 }
 
 // The sim-to-real augmentation keys (SensorAugmentOptions), directly under `train:`.
@@ -296,14 +348,11 @@ static DetectorOptions readDetectorOptions(YamlReader r) {
   readTrain(r.child("train"), &o.train);
   r.finish();
   try {
-    o.model.validate();
+    o.validate();
+  } catch (const OptionError& e) {
+    r.fail(e.key(), e.value().empty() ? e.reason() : e.reason() + ", got " + e.value());
   } catch (const std::invalid_argument& e) {
     r.fail("", e.what());
-  }
-  try {
-    o.validateGridExtent();
-  } catch (const std::invalid_argument& e) {
-    r.fail("inference.grid_extent", e.what());
   }
   return o;
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 
@@ -86,13 +87,18 @@ OfflinePipeline::OfflinePipeline(const PipelineConfig& c) : stages_(c.stages) {
       o.inference.score_threshold =
           static_cast<float>(pipelineDetectorThreshold(c.package_dir, o.inference.score_threshold));
     }
-    if (!c.grid_extent.empty()) {
-      o.inference.grid_extent = c.grid_extent;
-      try {
-        o.validateGridExtent();
-      } catch (const std::invalid_argument& e) {
-        throw std::runtime_error(std::string("--grid-extent: ") + e.what());
-      }
+    try {
+      if (!c.grid_extent.empty()) o.inference.grid_extent = GridExtent::fromValues(c.grid_extent);
+      o.validate();
+    } catch (const OptionError& e) {
+      // The command line's options by their names; other keys came with the model or --detector-config.
+      const std::map<std::string, std::string> flags = {{"grid_extent", "--grid-extent"},
+                                                        {"inference.grid_extent", "--grid-extent"},
+                                                        {"inference.score_threshold", "--score-threshold"},
+                                                        {"inference.threads", "--threads"}};
+      const auto flag = flags.find(e.key());
+      throw std::runtime_error(flag == flags.end() ? path + ": " + e.what()
+                                                   : flag->second + ": " + e.value() + ": " + e.reason());
     }
     detector_ = std::make_unique<Detector>(o);
     desc << "; detector " << path << " (" << headTypeName(o.model.head) << " head, " << detector_->parameterCount()

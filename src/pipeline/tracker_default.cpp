@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "ret3d/core/yaml_reader.h"
+#include "ret3d/detector/detector_options.h"
 
 namespace ret3d {
 namespace pipeline {
@@ -25,7 +26,7 @@ double pipelineDetectorThreshold(const std::string& package_dir, double fallback
   const std::string path = (std::filesystem::path(package_dir) / kPipelineParams).string();
   if (package_dir.empty() || !std::filesystem::exists(path)) return fallback;
   double v = fallback;
-  YamlReader::load(path).child("ret3d_detector").get("score_threshold", &v, 0.0, 1.0);
+  YamlReader::load(path).child("ret3d_detector").get("score_threshold", &v, InferenceOptions::kScoreThreshold);
   return v;
 }
 

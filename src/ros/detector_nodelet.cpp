@@ -62,7 +62,9 @@ class DetectorNodelet : public StageNodelet<sensor_msgs::PointCloud2> {
   }
 
   // dynamic_reconfigure (cfg/Detector.cfg): the score threshold and the NMS IoU change between clouds. The server
-  // starts from the values the nodelet was configured with, not from the .cfg defaults.
+  // starts from the values the nodelet was configured with, not from the .cfg defaults. A value the detector's
+  // options refuse (InferenceOptions::validate, whose ranges the .cfg's repeat) changes nothing: a warning says why
+  // and the server reports the values in force.
   void startReconfigure() {
     reconfigure_ = std::make_unique<dynamic_reconfigure::Server<ret3d::DetectorConfig>>(reconfigure_mutex_,
                                                                                         getPrivateNodeHandle());
@@ -72,8 +74,16 @@ class DetectorNodelet : public StageNodelet<sensor_msgs::PointCloud2> {
     reconfigure_->updateConfig(start);
     reconfigure_->setCallback([this](ret3d::DetectorConfig& c, std::uint32_t) {
       std::lock_guard<std::mutex> lock(detector_mutex_);
-      detector_->setThresholds(c.score_threshold, c.nms_iou);
-      NODELET_INFO_STREAM("detector thresholds: score_threshold " << c.score_threshold << ", nms_iou " << c.nms_iou);
+      try {
+        detector_->setThresholds(c.score_threshold, c.nms_iou);
+        NODELET_INFO_STREAM("detector thresholds: score_threshold " << c.score_threshold << ", nms_iou " << c.nms_iou);
+      } catch (const OptionError& e) {
+        const InferenceOptions& kept = detector_->options().inference;
+        NODELET_WARN_STREAM("dynamic_reconfigure refused: " << e.what() << "; keeping score_threshold "
+                                                            << kept.score_threshold << ", nms_iou " << kept.nms_iou);
+        c.score_threshold = kept.score_threshold;
+        c.nms_iou = kept.nms_iou;
+      }
     });
   }
 

@@ -104,6 +104,14 @@ double ParamReader::number(const std::string& name, double fallback, double min,
   return x;
 }
 
+double ParamReader::number(const std::string& name, double fallback, const OptionRange& range) const {
+  return number(name, fallback, range.lo, range.hi);
+}
+
+int ParamReader::integer(const std::string& name, int fallback, const OptionRange& range) const {
+  return integer(name, fallback, static_cast<int>(range.lo), static_cast<int>(range.hi));
+}
+
 int ParamReader::integer(const std::string& name, int fallback, int min, int max) const {
   XmlRpc::XmlRpcValue v;
   int x = fallback;
@@ -181,22 +189,31 @@ DetectorNodeletParams loadDetectorNodeletParams(const ros::NodeHandle& private_n
     throw ParamError("parameter " + p.fullName(name) + " = '" + (config.empty() ? model_path : config) +
                      "': " + e.what());
   }
+  // Each parameter is the inference option of its name, in the range InferenceOptions keeps for it.
+  using I = InferenceOptions;
   InferenceOptions& inf = params.detector.inference;
-  inf.threads = p.integer("threads", inf.threads, 1, 64);
-  inf.score_threshold = static_cast<float>(p.number("score_threshold", inf.score_threshold, 0.0, 1.0));
-  inf.candidate_threshold = static_cast<float>(p.number("candidate_threshold", inf.candidate_threshold, 0.0, 1.0));
-  inf.nms_iou = p.number("nms_iou", inf.nms_iou, 0.01, 1.0);
-  inf.nms_voting_iou = p.number("nms_voting_iou", inf.nms_voting_iou, 0.0, 1.0);
-  inf.iou_score_power = p.number("iou_score_power", inf.iou_score_power, 0.0, 1.0);
+  inf.threads = p.integer("threads", inf.threads, I::kThreads);
+  inf.score_threshold = static_cast<float>(p.number("score_threshold", inf.score_threshold, I::kScoreThreshold));
+  inf.candidate_threshold =
+      static_cast<float>(p.number("candidate_threshold", inf.candidate_threshold, I::kCandidateThreshold));
+  inf.nms_iou = p.number("nms_iou", inf.nms_iou, I::kNmsIou);
+  inf.nms_voting_iou = p.number("nms_voting_iou", inf.nms_voting_iou, I::kNmsVotingIou);
+  inf.iou_score_power = p.number("iou_score_power", inf.iou_score_power, I::kIouScorePower);
   // The model file's point refinement (boxes fitted to the raw returns) can only be switched off here.
   if (!p.boolean("point_refine", true)) inf.point_refine = PointRefineOptions();
-  inf.max_detections = p.integer("max_detections", inf.max_detections, 1, 100000);
+  inf.max_detections = p.integer("max_detections", inf.max_detections, I::kMaxDetections);
   // The ground the network covers (a trained model runs on a wider grid at a cost in proportion to its area).
-  inf.grid_extent = p.numbers("grid_extent", inf.grid_extent);
   try {
-    params.detector.validateGridExtent();
-  } catch (const std::invalid_argument& e) {
-    throw ParamError("parameter " + p.fullName("grid_extent") + ": " + e.what());
+    if (p.has("grid_extent")) inf.grid_extent = GridExtent::fromValues(p.numbers("grid_extent", {}));
+    params.detector.validate();
+  } catch (const OptionError& e) {
+    // The parameters above were read in validate()'s ranges and the model's own options checked when it was read:
+    // what is left to refuse is the grid extent.
+    if (e.key() == "grid_extent" || e.key() == "inference.grid_extent")
+      throw ParamError("parameter " + p.fullName("grid_extent") + " = " + e.value() + ": " + e.reason());
+    const std::string name = config.empty() ? "model_path" : "config";
+    throw ParamError("parameter " + p.fullName(name) + " = '" + (config.empty() ? model_path : config) +
+                     "': " + e.what());
   }
   const std::string scaling =
       p.choice("intensity_scaling", "auto", {"auto", "datatype", "observed_max", "fixed"});

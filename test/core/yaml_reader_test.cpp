@@ -1,6 +1,7 @@
 #include "ret3d/core/yaml_reader.h"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 
 #include <gtest/gtest.h>
@@ -163,6 +164,55 @@ TEST(YamlReader, FilesThatCannotBeReadAreNamed) {
   int k = 0;
   YamlReader::load(dir / "a.yaml").get("k", &k);
   EXPECT_EQ(k, 4);
+}
+
+// An ablation config holds what it changes: `base:` (relative to the file) is read first and the file laid over it.
+TEST(YamlReader, ABaseFileIsReadFirstAndTheFileOverridesItKeyByKey) {
+  test::TempDir dir;
+  std::filesystem::create_directories(dir / "sub");
+  std::ofstream(dir / "root.yaml") << "model: {rounds: 4, radius: 2.0}\ntrain: {lr: 0.001, iou: {Car: 0.7}}\n";
+  std::ofstream(dir / "sub/mid.yaml") << "base: ../root.yaml\nmodel: {rounds: 1}\nlist: [1, 2, 3]\n";
+  std::ofstream(dir / "leaf.yaml") << "base: sub/mid.yaml\ntrain: {lr: 0.002}\nlist: [9]\n";
+  YamlReader r = YamlReader::load(dir / "leaf.yaml");
+  YamlReader model = r.child("model"), train = r.child("train");
+  int rounds = 0;
+  double radius = 0, lr = 0, car_iou = 0;
+  std::vector<int> list;
+  model.get("rounds", &rounds);
+  model.get("radius", &radius);
+  train.get("lr", &lr);
+  train.child("iou").get("Car", &car_iou);
+  r.get("list", &list);
+  EXPECT_EQ(rounds, 1);               // the middle file's
+  EXPECT_DOUBLE_EQ(radius, 2.0);      // the root's, kept beside the middle file's rounds
+  EXPECT_DOUBLE_EQ(lr, 0.002);        // the leaf's
+  EXPECT_DOUBLE_EQ(car_iou, 0.7);     // a nested map the leaf did not name
+  EXPECT_EQ(list, std::vector<int>{9});  // a list is replaced whole
+  EXPECT_FALSE(r.has("base"));
+  // readConfigText (the relation configs' way in) gives the same merged document.
+  YamlReader again = YamlReader::parse(readConfigText(dir / "leaf.yaml", "leaf"), "leaf");
+  again.child("model").get("radius", &radius);
+  EXPECT_DOUBLE_EQ(radius, 2.0);
+}
+
+TEST(YamlReader, ACycleOrAMissingBaseIsAnErrorNamingTheFiles) {
+  test::TempDir dir;
+  std::ofstream(dir / "a.yaml") << "base: b.yaml\nk: 1\n";
+  std::ofstream(dir / "b.yaml") << "base: a.yaml\nk: 2\n";
+  const std::string cycle = errorOf([&] { YamlReader::load(dir / "a.yaml"); });
+  expectHas(cycle, "key 'base': the bases form a cycle");
+  expectHas(cycle, "a.yaml -> ");
+  expectHas(cycle, "b.yaml -> ");
+  std::ofstream(dir / "self.yaml") << "base: self.yaml\n";
+  expectHas(errorOf([&] { YamlReader::load(dir / "self.yaml"); }), "cycle");
+  std::ofstream(dir / "orphan.yaml") << "base: gone.yaml\nk: 1\n";
+  const std::string missing = errorOf([&] { YamlReader::load(dir / "orphan.yaml"); });
+  expectHas(missing, "orphan.yaml: key 'base': the base file '" + (dir / "gone.yaml") + "' does not exist");
+  std::ofstream(dir / "list.yaml") << "base: [x.yaml]\n";
+  expectHas(errorOf([&] { YamlReader::load(dir / "list.yaml"); }), "key 'base': expected the path of a base file");
+  // Without a file there is no folder to resolve a base from: parse() refuses it as an unknown key.
+  YamlReader r = YamlReader::parse("base: a.yaml\n", "text");
+  expectHas(errorOf([&] { r.finish(); }), "key 'base': unknown key");
 }
 
 }  // namespace

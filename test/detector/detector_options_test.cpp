@@ -1,6 +1,8 @@
 #include "ret3d/detector/detector_options.h"
 
+#include <cmath>
 #include <fstream>
+#include <limits>
 
 #include <gtest/gtest.h>
 
@@ -8,6 +10,18 @@
 
 namespace ret3d {
 namespace {
+
+// The OptionError `f` throws (an empty one, and a test failure, when it throws none).
+template <typename F>
+OptionError optionErrorOf(F f) {
+  try {
+    f();
+  } catch (const OptionError& e) {
+    return e;
+  }
+  ADD_FAILURE() << "accepted";
+  return OptionError("", "", "");
+}
 
 TEST(DetectorOptions, ShippedConfigsLoadAndValidate) {
   for (const char* name : {"lwd3d_center.yaml", "lwd3d_anchor.yaml"}) {
@@ -93,6 +107,62 @@ TEST(DetectorOptions, ModelConfigRoundTripsAndDiffsReadably) {
   ASSERT_EQ(d.size(), 2u);
   EXPECT_EQ(d[0], "model.bev.resolution: 0.2 vs 0.25");
   EXPECT_EQ(d[1], "model.classes: [Car, Pedestrian, Cyclist] vs [Car]");
+}
+
+// One range per value: the YAML reader, the nodelet's parameters, dynamic_reconfigure and the command line all refuse
+// through InferenceOptions::validate(), naming the key, the value and the range.
+TEST(DetectorOptions, EveryInferenceValueHasOneRangeAndARefusalNamesKeyValueAndRange) {
+  auto message = [](const std::string& yaml) -> std::string {
+    try {
+      detectorOptionsFromYaml(yaml);
+    } catch (const std::runtime_error& e) {
+      return e.what();
+    }
+    return "";
+  };
+  // nms_iou had no check in YAML (and [0.01, 1] as a ROS parameter): now [0, 1] everywhere.
+  EXPECT_EQ(message("inference: {nms_iou: 1.5}"), "<string>: key 'inference.nms_iou': must lie in [0, 1], got 1.5");
+  EXPECT_EQ(message("inference: {nms_iou: 0}"), "");
+  EXPECT_EQ(message("inference: {max_detections: 0}"),
+            "<string>: key 'inference.max_detections': must lie in [1, 100000], got 0");
+  EXPECT_EQ(message("inference: {threads: 65}"), "<string>: key 'inference.threads': must lie in [1, 64], got 65");
+  EXPECT_EQ(message("inference: {heading_from_velocity: {Car: -1}}"),
+            "<string>: key 'inference.heading_from_velocity.Car': must be >= 0, got -1");
+
+  InferenceOptions o;
+  EXPECT_NO_THROW(o.validate());
+  o.nms_iou = std::nan("");
+  const OptionError e = optionErrorOf([&] { o.validate(); });
+  EXPECT_EQ(e.key(), "nms_iou");
+  EXPECT_EQ(e.reason(), "must lie in [0, 1]");
+  EXPECT_EQ(std::string(e.what()), "nms_iou = nan: must lie in [0, 1]");
+  DetectorOptions d;
+  d.inference.score_threshold = -0.5f;
+  EXPECT_EQ(optionErrorOf([&] { d.validate(); }).key(), "inference.score_threshold");
+}
+
+TEST(DetectorOptions, AGridExtentIsFourFiniteOrderedNumbersAndFitsTheModel) {
+  const GridExtent e = GridExtent::fromValues({-80, 80, -48, 48});
+  EXPECT_EQ(e.values(), (std::vector<double>{-80, 80, -48, 48}));
+  EXPECT_EQ(e.describe(), "[-80, 80, -48, 48]");
+  auto reason = [](const std::vector<double>& v) {
+    const OptionError e = optionErrorOf([&] { GridExtent::fromValues(v); });
+    EXPECT_EQ(e.key(), "grid_extent");
+    return e.reason();
+  };
+  EXPECT_EQ(reason({-80, 80, -48}), "expected [x_min, x_max, y_min, y_max], 4 numbers, not 3");
+  EXPECT_EQ(reason({-80, std::numeric_limits<double>::infinity(), -48, 48}), "must be finite numbers");
+  EXPECT_EQ(reason({-80, 80, 48, 48}), "y_max must exceed y_min");
+  // The shape is fine, but 360 cells are not a multiple of the model's coarsest stride (16): the model decides.
+  DetectorOptions d;
+  d.inference.grid_extent = GridExtent::fromValues({-45, 45, -48, 48});
+  const OptionError err = optionErrorOf([&] { d.validate(); });
+  EXPECT_EQ(err.key(), "inference.grid_extent");
+  EXPECT_EQ(err.value(), "[-45, 45, -48, 48]");
+  EXPECT_NE(err.reason().find("divisible by the coarsest stride 16"), std::string::npos) << err.reason();
+  d.inference.grid_extent = GridExtent::fromValues({-64, 64, -48, 48});
+  EXPECT_NO_THROW(d.validate());
+  EXPECT_EQ(d.inferenceGeometry().width(), 512);
 }
 
 }  // namespace

@@ -149,7 +149,7 @@ TEST(ModelFile, AModelCoversAWiderGridThanItWasTrainedOn) {
   o.model = smallModel(HeadType::Anchor);
   o.inference.model_path = path;
   o.inference.score_threshold = 0.0f;
-  o.inference.grid_extent = {-32, 32, -16, 16};
+  o.inference.grid_extent = GridExtent{-32, 32, -16, 16};
   Detector d(o);
   EXPECT_EQ(d.options().inferenceGeometry().width(), 256);
   EXPECT_EQ(d.options().inferenceGeometry().height(), 128);

@@ -231,6 +231,17 @@ TEST_F(DetectorNodeletTest, ThresholdsChangeAtRunTimeThroughDynamicReconfigure) 
   EXPECT_EQ(objectsAt(1.0), 0u);
   EXPECT_GT(objectsAt(0.0), 0u);
   EXPECT_FALSE(log_.find({"detector thresholds", "score_threshold 1"}).empty()) << log_.all();
+  // A value InferenceOptions::validate() refuses (NaN passes the server's own clamping) changes nothing, with a
+  // warning, and the server answers with the values in force.
+  dynamic_reconfigure::Reconfigure srv;
+  dynamic_reconfigure::DoubleParameter p;
+  p.name = "nms_iou", p.value = std::nan("");
+  srv.request.config.doubles.push_back(p);
+  EXPECT_TRUE(ros::service::call("/ret3d_detector/set_parameters", srv));
+  for (const auto& d : srv.response.config.doubles)
+    if (d.name == "nms_iou") EXPECT_DOUBLE_EQ(d.value, 1.0);
+  EXPECT_FALSE(log_.find({"dynamic_reconfigure refused", "nms_iou = nan: must lie in [0, 1]"}).empty()) << log_.all();
+  EXPECT_GT(objectsAt(0.0), 0u);  // still running
 }
 
 TEST_F(DetectorNodeletTest, ModelThatDoesNotFitTheConfigIsRefused) {

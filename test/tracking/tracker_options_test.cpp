@@ -38,6 +38,21 @@ TEST(TrackerOptions, ConfigFileEqualsStructDefaults) {
   expectSame(loaded, TrackerOptions());
 }
 
+// The LWD-3D files start from config/tracker.yaml (`base:`) and hold what differs: these are their values in full.
+TEST(TrackerOptions, TheLwd3dConfigsAreTheDefaultsWithTheirOverrides) {
+  const std::string dir = std::string(RET3D_SOURCE_DIR) + "/config/";
+  TrackerOptions training;  // InterRM's training data
+  training.score_threshold = 0.3;
+  training.birth_score = {0.5, 0.5, 0.5};
+  expectSame(loadTrackerOptions(dir + "tracker_lwd3d.yaml"), training);
+  TrackerOptions pipeline;  // online and offline behind the default detector
+  pipeline.gate = {2.0, 0.8, 0.6};
+  pipeline.score_threshold = 0.05;
+  pipeline.birth_score = {0.3, 0.3, 0.45};
+  pipeline.max_age = 10;
+  expectSame(loadTrackerOptions(dir + "tracker_lwd3d_pipeline.yaml"), pipeline);
+}
+
 TEST(TrackerOptions, ReadsEveryKey) {
   const TrackerOptions o = parseTrackerOptions(
       "assignment: hungarian\n"

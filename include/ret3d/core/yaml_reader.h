@@ -3,6 +3,11 @@
 // range, each with a message naming the file, the full key path and the reason, e.g.
 //   config/tracker.yaml: key 'gate.Truck': unknown class (line 3; classes: Car, Pedestrian, Cyclist)
 // An absent key leaves its value as it was, so an options struct's defaults apply to whatever a file does not set.
+//
+// A file may start from another: a top-level `base: other.yaml` (relative to the file) reads that file first and lays
+// this one over it, maps merged key by key and any other value (a number, a list) replaced whole, so an ablation
+// config holds only what it changes. A base may have a base; a cycle or a missing base file is an error naming the
+// file. Line numbers in messages about such a file count lines of the merged document.
 #pragma once
 
 #include <initializer_list>
@@ -14,6 +19,7 @@
 #include <utility>
 #include <vector>
 
+#include "ret3d/core/option_range.h"
 #include "ret3d/core/per_class.h"
 #include "ret3d/core/types.h"
 
@@ -29,7 +35,8 @@ class ConfigError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// The whole text of a configuration file; ConfigError "ORIGIN: cannot be read" when it cannot be.
+// The whole text of a configuration file, its `base:` chain resolved (the merged document, without `base`);
+// ConfigError "ORIGIN: cannot be read" when it cannot be, or naming the key `base` when a base is wrong.
 std::string readConfigText(const std::string& file, const std::string& origin);
 
 class YamlReader {
@@ -40,7 +47,8 @@ class YamlReader {
   // `path` is the key path of the document when it is one section read alone (e.g. "model"). Bad syntax fails
   // naming the line. An empty document reads as an empty map.
   static YamlReader parse(const std::string& text, const std::string& origin, const std::string& path = "");
-  // The document in `file`, named by its path.
+  // The document in `file`, named by its path, its `base:` chain resolved (readConfigText). parse() knows no
+  // folder to resolve a base from: there `base` is an unknown key like any other.
   static YamlReader load(const std::string& file);
 
   YamlReader(YamlReader&&) noexcept;
@@ -55,8 +63,13 @@ class YamlReader {
   // The same, and a number must lie in [lo, hi] (kNoLimit for an open end).
   template <typename T>
   bool get(const std::string& key, T* value, double lo, double hi) {
+    return get(key, value, OptionRange{lo, hi});
+  }
+  // The same in the range an options struct keeps for the value (e.g. InferenceOptions::kScoreThreshold).
+  template <typename T>
+  bool get(const std::string& key, T* value, const OptionRange& range) {
     if (!get(key, value)) return false;
-    within(key, static_cast<double>(*value), lo, hi);
+    within(key, static_cast<double>(*value), range);
     return true;
   }
   // One of the named `choices`, e.g. head: anchor | center.
@@ -96,7 +109,8 @@ class YamlReader {
   // Refuses every key of this map that nothing read (a typo), naming the keys that were read.
   void finish() const;
   // Refuses v outside [lo, hi] (kNoLimit: an open end) naming `key`: the one range check of every reader.
-  void within(const std::string& key, double v, double lo, double hi) const;
+  void within(const std::string& key, double v, double lo, double hi) const { within(key, v, OptionRange{lo, hi}); }
+  void within(const std::string& key, double v, const OptionRange& range) const;
   // Throws ConfigError "ORIGIN: key 'PATH.key': REASON" ("ORIGIN: REASON" for the key "" of the document).
   [[noreturn]] void fail(const std::string& key, const std::string& reason) const;
   // The dotted path of `key` below this map, e.g. "model.bev.resolution".

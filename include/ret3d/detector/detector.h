@@ -29,7 +29,7 @@ class Detector {
  public:
   // Loads options.inference.model_path, refusing a file whose model differs from options.model (the message lists
   // what differs); with an empty path the network is freshly initialised (tests). Sets torch's thread count. Throws
-  // std::invalid_argument for an inference.grid_extent the network cannot run on (validateGridExtent).
+  // std::invalid_argument (OptionError naming the key) for options DetectorOptions::validate() refuses.
   explicit Detector(const DetectorOptions& options);
   // Wraps an existing model (training: validation with the model being trained); the options' model part must match.
   Detector(const DetectorOptions& options, std::shared_ptr<nn::DetectorModel> model);
@@ -44,7 +44,8 @@ class Detector {
                     const Eigen::Isometry3d& prev_to_current = Eigen::Isometry3d::Identity());
 
   const DetectorOptions& options() const { return options_; }
-  // Changes the inference thresholds between calls (dynamic_reconfigure); throws std::invalid_argument outside [0, 1].
+  // Changes the inference thresholds between calls (dynamic_reconfigure); throws OptionError, changing nothing, for a
+  // value InferenceOptions::validate() refuses.
   void setThresholds(double score_threshold, double nms_iou);
   const DetectorTimings& lastTimings() const { return timings_; }
   int featureDim() const;

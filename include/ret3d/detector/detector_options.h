@@ -3,10 +3,12 @@
 // compared on load); the `inference` part may change freely at run time; `train` drives `ret3d train detector`.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "ret3d/bev/bev_encoder.h"
+#include "ret3d/core/option_range.h"
 #include "ret3d/core/types.h"
 #include "ret3d/detector/point_refine.h"
 
@@ -69,6 +71,20 @@ struct ModelConfig {
   void validate() const;
 };
 
+// The ground the network runs on (inference.grid_extent), in metres. fromValues() checks its shape once; whether the
+// model can run on it (whole cells, divisible by the coarsest stride) needs the model: DetectorOptions::validate().
+struct GridExtent {
+  double x_min = 0, x_max = 0, y_min = 0, y_max = 0;
+
+  // [x_min, x_max, y_min, y_max] as YAML, a ROS parameter or --grid-extent give it. Throws OptionError (key
+  // "grid_extent") unless four finite numbers with x_min < x_max and y_min < y_max.
+  static GridExtent fromValues(const std::vector<double>& values);
+  std::vector<double> values() const { return {x_min, x_max, y_min, y_max}; }
+  std::string describe() const;  // "[-80, 80, -48, 48]"
+  // `g` over this extent; its resolution and heights kept.
+  BevGeometry appliedTo(BevGeometry g) const;
+};
+
 struct InferenceOptions {
   std::string model_path;      // empty: the network is freshly initialised (tests, training)
   int threads = 2;             // torch intra-op threads and BEV workers
@@ -94,10 +110,24 @@ struct InferenceOptions {
   PointRefineOptions point_refine;
   // Per class, the speed (m/s) from which a box takes the heading of its velocity (headingFromVelocity); empty = off.
   std::vector<std::pair<ObjectClass, double>> heading_from_velocity;
-  // The grid the network runs on, [x_min, x_max, y_min, y_max] in metres; empty = the model's. The network is fully
-  // convolutional (its attention's positions come from a convolution), so a trained model may cover more ground
-  // than it was trained on, at a cost proportional to the area; the resolution and the heights stay the model's.
-  std::vector<double> grid_extent;
+  // The grid the network runs on; none = the model's. The network is fully convolutional (its attention's positions
+  // come from a convolution), so a trained model may cover more ground than it was trained on, at a cost
+  // proportional to the area; the resolution and the heights stay the model's.
+  std::optional<GridExtent> grid_extent;
+
+  // The one allowed range of each number: YAML, the detector nodelet's parameters, cfg/Detector.cfg (a test keeps
+  // its ranges equal to these) and the command line all check these.
+  static constexpr OptionRange kThreads{1, 64};
+  static constexpr OptionRange kScoreThreshold{0, 1};
+  static constexpr OptionRange kCandidateThreshold{0, 1};
+  static constexpr OptionRange kMaxCandidates{1, 100000};
+  static constexpr OptionRange kMaxDetections{1, 100000};
+  static constexpr OptionRange kNmsIou{0, 1};  // 0: any overlap with a better box of the class suppresses
+  static constexpr OptionRange kNmsVotingIou{0, 1};
+  static constexpr OptionRange kIouScorePower{0, 1};
+  static constexpr OptionRange kHeadingSpeed{0, std::numeric_limits<double>::infinity()};  // m/s
+  // Throws OptionError naming the first value outside its range (its key below `inference:`, e.g. "nms_iou").
+  void validate() const;
 };
 
 // Sim-to-real augmentation (include/ret3d/train/augmentations.h), applied to each training sample before the
@@ -187,9 +217,10 @@ struct DetectorOptions {
   BevEncoderOptions bevOptions() const;
   // The model's geometry with inference.grid_extent applied (what the encoder and the decoding use).
   BevGeometry inferenceGeometry() const;
-  // Throws std::invalid_argument unless inference.grid_extent is empty or [x_min, x_max, y_min, y_max] of a grid the
-  // network can run on (whole cells, divisible by the coarsest stride).
-  void validateGridExtent() const;
+  // model.validate() (std::invalid_argument), then inference.validate() and whether the network can run on
+  // inference.grid_extent (whole cells, divisible by the coarsest stride): OptionError with the key below the
+  // document, e.g. "inference.nms_iou", "inference.grid_extent".
+  void validate() const;
 };
 
 // Reads a YAML file; every key is optional (defaults above); an unknown key, a wrong type or an invalid value

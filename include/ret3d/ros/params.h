@@ -37,6 +37,9 @@ class ParamReader {
   std::string choice(const std::string& name, const std::string& fallback, const std::vector<std::string>& allowed) const;
   double number(const std::string& name, double fallback, double min, double max) const;  // inclusive range
   int integer(const std::string& name, int fallback, int min, int max) const;
+  // The same in the range an options struct keeps for the value (e.g. InferenceOptions::kNmsIou).
+  double number(const std::string& name, double fallback, const OptionRange& range) const;
+  int integer(const std::string& name, int fallback, const OptionRange& range) const;
   bool boolean(const std::string& name, bool fallback) const;
   std::vector<double> numbers(const std::string& name, const std::vector<double>& fallback) const;  // a list
   bool has(const std::string& name) const { return nh_.hasParam(name); }

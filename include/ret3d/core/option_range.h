@@ -1,0 +1,43 @@
+// The allowed range of a numeric option, kept beside its options struct so that every way in (YAML, ROS parameters,
+// dynamic_reconfigure, the command line) checks the same range and says it in the same words; and the error an
+// options struct's validate() throws, naming the key, the value and what is allowed.
+#pragma once
+
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace ret3d {
+
+struct OptionRange {
+  double lo = -std::numeric_limits<double>::infinity();
+  double hi = std::numeric_limits<double>::infinity();
+
+  bool contains(double v) const { return v >= lo && v <= hi; }  // false for NaN
+  // "must lie in [0, 1]", "must be >= 1" or "must be <= 5".
+  std::string describe() const;
+};
+
+// what(): "KEY = VALUE: REASON", e.g. "nms_iou = 1.5: must lie in [0, 1]" ("KEY: REASON" without a value, for a
+// part checked as a whole). The key is the option's YAML key below
+// its struct (e.g. "nms_iou", "grid_extent"), which each reader turns into its own name for it.
+class OptionError : public std::invalid_argument {
+ public:
+  OptionError(const std::string& key, const std::string& value, const std::string& reason);
+  const std::string& key() const { return key_; }
+  const std::string& value() const { return value_; }
+  const std::string& reason() const { return reason_; }
+  // The same error for the key under `prefix` (e.g. "inference" + "nms_iou").
+  OptionError under(const std::string& prefix) const;
+
+ private:
+  std::string key_, value_, reason_;
+};
+
+// A number as messages show it (shortest form: 0.1, 1e-06).
+std::string optionValueText(double v);
+
+// Throws OptionError(key, v, range.describe()) unless range.contains(v).
+void checkOption(const std::string& key, double v, const OptionRange& range);
+
+}  // namespace ret3d
