@@ -7,10 +7,8 @@
 namespace ret3d {
 namespace relation {
 
-InterRM::InterRM(const InterRMOptions& options) : impl_(std::make_unique<Impl>()) {
-  if (options.model_path.empty()) throw std::runtime_error("InterRM: no model file given (model_path is empty)");
-  loadInterRMModel(options.model_path, impl_.get());
-  const InterRMArch& a = impl_->info.config.model;
+InterRM::InterRM(const InterRMOptions& options) : RelationModule(options.model_path) {
+  const InterRMArch& a = arch();
   const std::string where = "InterRM model " + options.model_path + ": ";
   if (options.c_enc >= 0 && options.c_enc != a.c_enc)
     throw std::runtime_error(where + "has C_enc " + std::to_string(a.c_enc) + ", the options ask for " +
@@ -19,24 +17,8 @@ InterRM::InterRM(const InterRMOptions& options) : impl_(std::make_unique<Impl>()
       options.positional_encoding != positionalEncodingName(a.positional_encoding))
     throw std::runtime_error(where + "was trained with the " + positionalEncodingName(a.positional_encoding) +
                              " positional encoding, the options ask for " + options.positional_encoding);
-  if (options.threads > 0) torch::set_num_threads(options.threads);
+  setTorchThreads(options.threads);
 }
-
-InterRM::InterRM(const InterRMArch& arch, std::uint64_t seed) : impl_(std::make_unique<Impl>()) {
-  torch::manual_seed(seed);
-  impl_->info.format_version = kInterRMFormatVersion;
-  impl_->info.config.model = arch;
-  impl_->net = InterRMNet(arch);
-  impl_->net->eval();
-}
-
-InterRM::~InterRM() = default;
-InterRM::InterRM(InterRM&&) noexcept = default;
-InterRM& InterRM::operator=(InterRM&&) noexcept = default;
-
-const InterRMArch& InterRM::arch() const { return impl_->info.config.model; }
-const InterRMModelInfo& InterRM::info() const { return impl_->info; }
-void InterRM::save(const std::string& path) const { saveInterRMModel(path, *impl_); }
 
 std::vector<Box> InterRM::refine(const std::vector<InterRMSequence>& sequences) const {
   if (sequences.empty()) return {};

@@ -1,8 +1,6 @@
 // InterRM configuration from YAML (config/relation/inter_rm.yaml): one loader, loud on typos.
 #include <stdexcept>
 
-#include <yaml-cpp/yaml.h>
-
 #include "config_sections.h"
 
 #include "ret3d/relation/inter_rm.h"
@@ -10,14 +8,14 @@
 namespace ret3d {
 namespace relation {
 
-const char* positionalEncodingName(InterPositionalEncoding pe) {
-  switch (pe) {
-    case InterPositionalEncoding::Implicit: return "implicit";
-    case InterPositionalEncoding::Temporal: return "temporal";
-    case InterPositionalEncoding::Spatial: return "spatial";
-  }
-  return "?";
-}
+namespace {
+
+const std::initializer_list<std::pair<const char*, InterPositionalEncoding>> kPositionalEncodings = {
+    {"implicit", InterPositionalEncoding::Implicit},
+    {"temporal", InterPositionalEncoding::Temporal},
+    {"spatial", InterPositionalEncoding::Spatial}};
+
+}  // namespace
 
 void InterRMArch::validate() const {
   auto bad = [](const std::string& m) { throw std::invalid_argument("InterRM model: " + m); };
@@ -40,59 +38,31 @@ void InterRMTrainConfig::validate() const {
     if (!(reg_min_iou.at(k) > 0 && reg_min_iou.at(k) <= 1)) bad("reg_min_iou values must be in (0, 1]");
 }
 
+// The keys, in the order toYaml writes them.
+template <class ConfigIO>
+void visitConfig(ConfigIO& io, InterRMConfig* c) {
+  InterRMArch& m = c->model;
+  const detail::Choice<InterPositionalEncoding> pe{&m.positional_encoding, kPositionalEncodings};
+  io.section("model", "c_enc", &m.c_enc, "heads", &m.heads, "ffn_expansion", &m.ffn_expansion, "positional_encoding",
+             pe, "max_history", &m.max_history, "regress_size", &m.regress_size);
+  InterRMTrainConfig& t = c->train;
+  io.section("train", "lr", &t.lr, "weight_decay", &t.weight_decay, "sequences_per_batch", &t.sequences_per_batch,
+             "epochs", &t.epochs, "smooth_l1_beta", &t.smooth_l1_beta, "reg_min_iou", &t.reg_min_iou, "augment_flip",
+             &t.augment_flip, "seed", &t.seed);
+}
+
 InterRMConfig parseInterRMConfig(const std::string& yaml_text, const std::string& source) {
-  return detail::readConfigSections<InterRMConfig>(
-      "InterRM", yaml_text, source, [](YamlReader& m, YamlReader& t, InterRMConfig* c) {
-        m.get("regress_size", &c->model.regress_size);
-        m.get("c_enc", &c->model.c_enc);
-        m.get("heads", &c->model.heads);
-        m.get("ffn_expansion", &c->model.ffn_expansion);
-        m.getChoice("positional_encoding", &c->model.positional_encoding,
-                    {{"implicit", InterPositionalEncoding::Implicit},
-                     {"temporal", InterPositionalEncoding::Temporal},
-                     {"spatial", InterPositionalEncoding::Spatial}});
-        m.get("max_history", &c->model.max_history);
-        t.get("lr", &c->train.lr);
-        t.get("weight_decay", &c->train.weight_decay);
-        t.get("sequences_per_batch", &c->train.sequences_per_batch);
-        t.get("epochs", &c->train.epochs);
-        t.get("smooth_l1_beta", &c->train.smooth_l1_beta);
-        t.get("augment_flip", &c->train.augment_flip);
-        t.get("seed", &c->train.seed);
-        t.getPerClass("reg_min_iou", &c->train.reg_min_iou);
-      });
+  return detail::readConfig<InterRMConfig>("InterRM", yaml_text, source);
 }
 
-InterRMConfig loadInterRMConfig(const std::string& path) {
-  return parseInterRMConfig(readConfigText(path, "InterRM config " + path), path);
-}
+InterRMConfig loadInterRMConfig(const std::string& path) { return loadConfig(parseInterRMConfig, "InterRM", path); }
 
-std::string toYaml(const InterRMConfig& c) {
-  YAML::Emitter e;
-  e << YAML::BeginMap;
-  e << YAML::Key << "model" << YAML::Value << YAML::BeginMap;
-  e << YAML::Key << "c_enc" << YAML::Value << c.model.c_enc;
-  e << YAML::Key << "heads" << YAML::Value << c.model.heads;
-  e << YAML::Key << "ffn_expansion" << YAML::Value << c.model.ffn_expansion;
-  e << YAML::Key << "positional_encoding" << YAML::Value << positionalEncodingName(c.model.positional_encoding);
-  e << YAML::Key << "max_history" << YAML::Value << c.model.max_history;
-  e << YAML::Key << "regress_size" << YAML::Value << c.model.regress_size;
-  e << YAML::EndMap;
-  e << YAML::Key << "train" << YAML::Value << YAML::BeginMap;
-  e << YAML::Key << "lr" << YAML::Value << c.train.lr;
-  e << YAML::Key << "weight_decay" << YAML::Value << c.train.weight_decay;
-  e << YAML::Key << "sequences_per_batch" << YAML::Value << c.train.sequences_per_batch;
-  e << YAML::Key << "epochs" << YAML::Value << c.train.epochs;
-  e << YAML::Key << "smooth_l1_beta" << YAML::Value << c.train.smooth_l1_beta;
-  e << YAML::Key << "reg_min_iou" << YAML::Value << YAML::BeginMap;
-  for (ObjectClass k : kDetectedClasses)
-    e << YAML::Key << className(k) << YAML::Value << c.train.reg_min_iou.at(k);
-  e << YAML::EndMap;
-  e << YAML::Key << "augment_flip" << YAML::Value << c.train.augment_flip;
-  e << YAML::Key << "seed" << YAML::Value << c.train.seed;
-  e << YAML::EndMap;
-  e << YAML::EndMap;
-  return e.c_str();
+template std::string toYaml(const InterRMConfig& config);
+
+const char* positionalEncodingName(InterPositionalEncoding pe) {
+  for (const auto& [name, value] : kPositionalEncodings)
+    if (value == pe) return name;
+  return "?";
 }
 
 }  // namespace relation

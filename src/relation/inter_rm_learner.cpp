@@ -3,13 +3,8 @@
 #include "ret3d/relation/inter_rm_learner.h"
 
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 #include <random>
-#include <sstream>
 #include <stdexcept>
-
-#include <yaml-cpp/yaml.h>
 
 #include "inter_rm_network.h"
 #include "learner_checkpoint.h"
@@ -17,8 +12,6 @@
 
 namespace ret3d {
 namespace relation {
-
-namespace fs = std::filesystem;
 
 std::array<float, 7> interResiduals(const Box& c, const Box& t) {
   const double cs = std::cos(c.yaw), sn = std::sin(c.yaw);
@@ -33,60 +26,51 @@ std::array<float, 7> interResiduals(const Box& c, const Box& t) {
            static_cast<float>(dyaw)}};
 }
 
-struct InterRMLearner::Impl {
-  InterRMConfig config;
-  InterRM model;
-  std::unique_ptr<torch::optim::AdamW> optimizer;
-  std::mt19937_64 rng;
+using Learner = InterRMLearner::Impl;
 
-  Impl(const InterRMConfig& c, std::uint64_t seed) : config(c), model(c.model, seed), rng(seed) {
-    model.impl().info.config = c;
-    optimizer = std::make_unique<torch::optim::AdamW>(
-        model.impl().net->parameters(), torch::optim::AdamWOptions(c.train.lr).weight_decay(c.train.weight_decay));
-  }
-  InterRMNet& net() { return model.impl().net; }
-
-  std::pair<torch::Tensor, InterRMLoss> loss(const std::vector<const InterRMSample*>& batch) {
-    std::vector<const InterRMSequence*> seqs;
-    torch::Tensor target = torch::zeros({static_cast<int64_t>(batch.size()), kInterOutputs});
-    auto acc = target.accessor<float, 2>();
-    for (std::size_t i = 0; i < batch.size(); ++i) {
-      seqs.push_back(&batch[i]->sequence);
-      const auto r = interResiduals(batch[i]->sequence.boxes.at(0), batch[i]->target);
-      for (int k = 0; k < kInterOutputs; ++k) acc[static_cast<int64_t>(i)][k] = r[static_cast<std::size_t>(k)];
-    }
-    const torch::Tensor pred = net()->forward(makeInterRMInputs(seqs, config.model.max_history));
-    torch::Tensor l = torch::smooth_l1_loss(pred, target, at::Reduction::None, config.train.smooth_l1_beta);
-    if (!config.model.regress_size) {  // the size outputs are not used: no loss on them
-      torch::Tensor w = torch::ones({1, kInterOutputs});
-      w.slice(1, 3, 6).zero_();
-      l = l * w;
-    }
-    const torch::Tensor per = l.sum(1);  // per sequence: all seven residuals
-    const torch::Tensor total = per.mean();
-    InterRMLoss L;
-    L.total = total.item<double>();
-    L.loc = l.slice(1, 0, 3).sum(1).mean().item<double>();
-    L.size = l.slice(1, 3, 6).sum(1).mean().item<double>();
-    L.yaw = l.slice(1, 6, 7).sum(1).mean().item<double>();
-    L.sequences = batch.size();
-    return {total, L};
-  }
-};
-
-InterRMLearner::InterRMLearner(const InterRMConfig& config, std::uint64_t seed)
-    : impl_(std::make_unique<Impl>(config, seed)) {
-  config.model.validate();
-  config.train.validate();
+std::ostream& operator<<(std::ostream& out, const InterRMLoss& loss) {
+  return out << "(loc " << loss.loc << " size " << loss.size << " yaw " << loss.yaw << ")";
 }
 
-InterRMLearner::~InterRMLearner() = default;
+bool sameNetwork(const InterRMArch& a, const InterRMArch& b) {
+  return a.c_enc == b.c_enc && a.heads == b.heads && a.ffn_expansion == b.ffn_expansion &&
+         a.positional_encoding == b.positional_encoding && a.max_history == b.max_history &&
+         a.regress_size == b.regress_size;
+}
 
-void InterRMLearner::fitNormalisation(const std::vector<InterRMSample>& samples) {
+std::pair<torch::Tensor, InterRMLoss> batchLoss(Learner& learner, const std::vector<const InterRMSample*>& batch) {
+  const InterRMConfig& config = learner.config;
+  std::vector<const InterRMSequence*> seqs;
+  torch::Tensor target = torch::zeros({static_cast<int64_t>(batch.size()), kInterOutputs});
+  auto acc = target.accessor<float, 2>();
+  for (std::size_t i = 0; i < batch.size(); ++i) {
+    seqs.push_back(&batch[i]->sequence);
+    const auto r = interResiduals(batch[i]->sequence.boxes.at(0), batch[i]->target);
+    for (int k = 0; k < kInterOutputs; ++k) acc[static_cast<int64_t>(i)][k] = r[static_cast<std::size_t>(k)];
+  }
+  const torch::Tensor pred = learner.net()->forward(makeInterRMInputs(seqs, config.model.max_history));
+  torch::Tensor l = torch::smooth_l1_loss(pred, target, at::Reduction::None, config.train.smooth_l1_beta);
+  if (!config.model.regress_size) {  // the size outputs are not used: no loss on them
+    torch::Tensor w = torch::ones({1, kInterOutputs});
+    w.slice(1, 3, 6).zero_();
+    l = l * w;
+  }
+  const torch::Tensor per = l.sum(1);  // per sequence: all seven residuals
+  const torch::Tensor total = per.mean();
+  InterRMLoss L;
+  L.total = total.item<double>();
+  L.loc = l.slice(1, 0, 3).sum(1).mean().item<double>();
+  L.size = l.slice(1, 3, 6).sum(1).mean().item<double>();
+  L.yaw = l.slice(1, 6, 7).sum(1).mean().item<double>();
+  L.sequences = batch.size();
+  return {total, L};
+}
+
+void fitInputNormalisation(Learner& learner, const std::vector<InterRMSample>& samples) {
   std::vector<double> sum(kInterBasicFeatures, 0), sq(kInterBasicFeatures, 0);
   double count = 0;
   float f[kInterBasicFeatures];
-  const std::size_t max_h = static_cast<std::size_t>(impl_->config.model.max_history);
+  const std::size_t max_h = static_cast<std::size_t>(learner.config.model.max_history);
   for (const InterRMSample& s : samples) {
     for (std::size_t k = 0; k < std::min(max_h, s.sequence.boxes.size()); ++k) {
       interBasicFeatures(s.sequence, k, f);
@@ -96,7 +80,7 @@ void InterRMLearner::fitNormalisation(const std::vector<InterRMSample>& samples)
   }
   if (count < 2) return;
   torch::NoGradGuard no_grad;
-  auto& net = impl_->net();
+  auto& net = learner.net();
   for (int j = 0; j < kInterBasicFeatures; ++j) {
     if (j == 6 || j == 7 || (j >= 11 && j <= 13)) continue;  // heading sin/cos and one-hot are already in [-1, 1]
     const double mu = sum[j] / count;
@@ -106,8 +90,8 @@ void InterRMLearner::fitNormalisation(const std::vector<InterRMSample>& samples)
   }
 }
 
-InterRMLoss InterRMLearner::step(const std::vector<const InterRMSample*>& batch) {
-  // Augmentation: mirror the whole scene (y -> -y) with probability 0.5; features and residuals follow.
+// Mirrors the whole scene (y -> -y) with probability 0.5; features and residuals follow.
+std::vector<InterRMSample> augmented(Learner& learner, const std::vector<const InterRMSample*>& batch) {
   std::vector<InterRMSample> copies;
   copies.reserve(batch.size());
   std::bernoulli_distribution flip(0.5);
@@ -118,31 +102,22 @@ InterRMLoss InterRMLearner::step(const std::vector<const InterRMSample*>& batch)
   };
   for (const InterRMSample* s : batch) {
     copies.push_back(*s);
-    if (impl_->config.train.augment_flip && flip(impl_->rng)) {
+    if (learner.config.train.augment_flip && flip(learner.rng)) {
       for (Box& b : copies.back().sequence.boxes) mirror(b);
       mirror(copies.back().target);
     }
   }
-  std::vector<const InterRMSample*> ptrs;
-  for (const auto& c : copies) ptrs.push_back(&c);
-  impl_->net()->train();
-  auto [total, L] = impl_->loss(ptrs);
-  impl_->optimizer->zero_grad();
-  total.backward();
-  torch::nn::utils::clip_grad_norm_(impl_->net()->parameters(), 10.0);
-  impl_->optimizer->step();
-  impl_->net()->eval();
-  return L;
+  return copies;
 }
 
-InterRMLoss InterRMLearner::evaluate(const std::vector<InterRMSample>& samples) const {
-  torch::NoGradGuard no_grad;
+// The mean per sequence, in batches of 256.
+InterRMLoss meanLoss(Learner& learner, const std::vector<InterRMSample>& samples) {
   InterRMLoss sum;
   const std::size_t bs = 256;
   for (std::size_t s = 0; s < samples.size(); s += bs) {
     std::vector<const InterRMSample*> batch;
     for (std::size_t i = s; i < std::min(samples.size(), s + bs); ++i) batch.push_back(&samples[i]);
-    const InterRMLoss L = impl_->loss(batch).second;
+    const InterRMLoss L = batchLoss(learner, batch).second;
     const double n = static_cast<double>(batch.size());
     sum.total += L.total * n, sum.loc += L.loc * n, sum.size += L.size * n, sum.yaw += L.yaw * n;
     sum.sequences += batch.size();
@@ -154,32 +129,7 @@ InterRMLoss InterRMLearner::evaluate(const std::vector<InterRMSample>& samples) 
   return sum;
 }
 
-const InterRM& InterRMLearner::model() const { return impl_->model; }
-
-void InterRMLearner::setTrainedOn(const std::string& text) { impl_->model.impl().info.trained_on = text; }
-
-void InterRMLearner::saveCheckpoint(const std::string& dir, int epoch, double best_val) const {
-  fs::create_directories(dir);
-  impl_->model.save(dir + "/model.pt");
-  writeLearnerCheckpoint(dir, *impl_->optimizer, epoch, best_val, impl_->rng);
-}
-
-bool InterRMLearner::loadCheckpoint(const std::string& dir, int* epoch, double* best_val) {
-  if (!readLearnerState(dir, "InterRM", epoch, best_val, &impl_->rng)) return false;
-  InterRMOptions o;
-  o.model_path = dir + "/model.pt";
-  InterRM saved(o);
-  const InterRMArch& a = saved.arch();
-  const InterRMArch& b = impl_->config.model;
-  if (a.c_enc != b.c_enc || a.heads != b.heads || a.ffn_expansion != b.ffn_expansion ||
-      a.positional_encoding != b.positional_encoding || a.max_history != b.max_history ||
-      a.regress_size != b.regress_size)
-    throw std::runtime_error("InterRM checkpoint " + dir + ": its network differs from the configuration (" +
-                             toYaml({a, {}}) + ")");
-  copyWeights(*saved.impl().net, *impl_->net());
-  readLearnerOptimizer(dir, "InterRM", impl_->optimizer.get());
-  return true;
-}
+template class RelationLearner<InterRM, InterRMSample, InterRMLoss>;
 
 }  // namespace relation
 }  // namespace ret3d

@@ -4,9 +4,6 @@
 #include <cmath>
 #include <stdexcept>
 
-#include <yaml-cpp/yaml.h>
-
-#include "model_archive.h"
 #include "ret3d/core/geometry.h"
 
 namespace ret3d {
@@ -190,93 +187,9 @@ std::vector<Box> applyInterRMOutput(const std::vector<const InterRMSequence*>& s
 
 // ---- model file ----
 
-namespace {
+template class RelationModule<InterRMImpl, InterRMConfig>;
 
-[[noreturn]] void bad(const std::string& path, const std::string& msg) {
-  throw std::runtime_error("InterRM model " + path + ": " + msg);
-}
-
-InterRMModelInfo parseMetadataFields(const std::string& path, const std::string& text) {
-  YAML::Node m;
-  try {
-    m = YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    bad(path, std::string("metadata is not valid YAML: ") + e.what());
-  }
-  if (!m.IsMap() || !m["format"] || m["format"].as<std::string>() != kInterRMFormatName)
-    bad(path, "not an InterRM model (metadata format is not '" + std::string(kInterRMFormatName) + "')");
-  InterRMModelInfo info;
-  info.format_version = m["format_version"] ? m["format_version"].as<int>() : 0;
-  if (info.format_version != kInterRMFormatVersion)
-    bad(path, "format version " + std::to_string(info.format_version) + ", this build reads version " +
-                  std::to_string(kInterRMFormatVersion));
-  std::vector<std::string> classes;
-  if (m["classes"]) classes = m["classes"].as<std::vector<std::string>>();
-  std::vector<std::string> ours;
-  for (ObjectClass c : kDetectedClasses) ours.push_back(className(c));
-  if (classes != ours) {
-    std::string got;
-    for (const auto& c : classes) got += (got.empty() ? "" : ",") + c;
-    bad(path, "trained for classes [" + got + "], this build detects [Car,Pedestrian,Cyclist]");
-  }
-  if (!m["basic_features"] || m["basic_features"].as<int>() != kInterBasicFeatures)
-    bad(path, "built for another feature layout (basic_features is not " + std::to_string(kInterBasicFeatures) + ")");
-  if (m["trained_on"]) info.trained_on = m["trained_on"].as<std::string>();
-  if (!m["config"]) bad(path, "metadata has no config");
-  YAML::Emitter e;
-  e << m["config"];
-  try {
-    info.config = parseInterRMConfig(e.c_str(), path + " (metadata)");
-  } catch (const std::exception& err) {
-    bad(path, err.what());
-  }
-  return info;
-}
-
-// A value of the wrong type (yaml-cpp's BadConversion) is refused like any other bad metadata, naming the file.
-InterRMModelInfo parseMetadata(const std::string& path, const std::string& text) {
-  try {
-    return parseMetadataFields(path, text);
-  } catch (const YAML::Exception& e) {
-    bad(path, std::string("unreadable metadata: ") + e.what());
-  }
-}
-
-}  // namespace
-
-std::string interRMMetadataYaml(const InterRMModelInfo& info) {
-  YAML::Emitter e;
-  e << YAML::BeginMap;
-  e << YAML::Key << "format" << YAML::Value << kInterRMFormatName;
-  e << YAML::Key << "format_version" << YAML::Value << kInterRMFormatVersion;
-  e << YAML::Key << "classes" << YAML::Value << YAML::Flow << YAML::BeginSeq;
-  for (ObjectClass c : kDetectedClasses) e << className(c);
-  e << YAML::EndSeq;
-  e << YAML::Key << "basic_features" << YAML::Value << kInterBasicFeatures;
-  e << YAML::Key << "trained_on" << YAML::Value << info.trained_on;
-  e << YAML::Key << "config" << YAML::Value << YAML::Load(toYaml(info.config));
-  e << YAML::EndMap;
-  return e.c_str();
-}
-
-InterRMModelInfo readInterRMModelInfo(const std::string& path) {
-  torch::serialize::InputArchive ar;
-  return parseMetadata(path, readModelMetadata(path, "InterRM", &ar));
-}
-
-void saveInterRMModel(const std::string& path, const InterRM::Impl& impl) {
-  saveModelArchive(path, *impl.net, interRMMetadataYaml(impl.info));
-}
-
-void loadInterRMModel(const std::string& path, InterRM::Impl* impl) {
-  torch::serialize::InputArchive ar;
-  InterRMModelInfo info = parseMetadata(path, readModelMetadata(path, "InterRM", &ar));
-  InterRMNet net(info.config.model);
-  loadModelParameters(ar, *net, path, "InterRM");
-  net->eval();
-  impl->info = std::move(info);
-  impl->net = net;
-}
+InterRMModelInfo readInterRMModelInfo(const std::string& path) { return readModuleInfo<InterRMImpl>(path); }
 
 }  // namespace relation
 }  // namespace ret3d

@@ -7,13 +7,12 @@
 
 #include <torch/torch.h>
 
+#include "model_archive.h"
 #include "ret3d/relation/inter_rm.h"
 
 namespace ret3d {
 namespace relation {
 
-inline constexpr int kInterRMFormatVersion = 1;
-inline constexpr const char* kInterRMFormatName = "ret3d-inter-rm";
 // Outputs: centre residual (3, current box frame), log-size residual (3), heading residual (1).
 inline constexpr int kInterOutputs = 7;
 
@@ -46,18 +45,14 @@ class InterRMNetImpl : public torch::nn::Module {
 };
 TORCH_MODULE(InterRMNet);
 
-struct InterRM::Impl {
-  InterRMModelInfo info;
-  InterRMNet net{nullptr};
+struct InterRMImpl : ModuleState<InterRMNet, InterRMConfig> {
+  inline static const ModelFormat kFormat{"InterRM", "ret3d-inter-rm", 1, kInterBasicFeatures, ArchiveLayout::Flat};
+  static constexpr auto parseConfig = &parseInterRMConfig;
 };
 
 // Applies predicted residuals (B x 7) to each sequence's current box.
 std::vector<Box> applyInterRMOutput(const std::vector<const InterRMSequence*>& sequences, const torch::Tensor& out,
                                     bool apply_size);
-
-std::string interRMMetadataYaml(const InterRMModelInfo& info);
-void saveInterRMModel(const std::string& path, const InterRM::Impl& impl);
-void loadInterRMModel(const std::string& path, InterRM::Impl* impl);  // throws std::runtime_error
 
 }  // namespace relation
 }  // namespace ret3d

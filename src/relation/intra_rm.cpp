@@ -8,14 +8,8 @@
 namespace ret3d {
 namespace relation {
 
-void setTorchThreads(int threads) {
-  if (threads > 0) torch::set_num_threads(threads);
-}
-
-IntraRM::IntraRM(const IntraRMOptions& options) : impl_(std::make_unique<Impl>()) {
-  if (options.model_path.empty()) throw std::runtime_error("IntraRM: no model file given (model_path is empty)");
-  loadIntraRMModel(options.model_path, impl_.get());
-  const IntraRMArch& a = impl_->info.config.model;
+IntraRM::IntraRM(const IntraRMOptions& options) : RelationModule(options.model_path) {
+  const IntraRMArch& a = arch();
   const std::string where = "IntraRM model " + options.model_path + ": ";
   if (options.radius >= 0 && std::abs(options.radius - a.radius) > 1e-9)
     throw std::runtime_error(where + "trained with radius " + std::to_string(a.radius) + " m, the options ask for " +
@@ -28,23 +22,6 @@ IntraRM::IntraRM(const IntraRMOptions& options) : impl_(std::make_unique<Impl>()
                              ", the options ask for " + std::to_string(options.feature_dim));
   setTorchThreads(options.threads);
 }
-
-IntraRM::IntraRM(const IntraRMArch& arch, std::uint64_t seed) : impl_(std::make_unique<Impl>()) {
-  torch::manual_seed(seed);
-  impl_->info.format_version = kIntraRMFormatVersion;
-  impl_->info.config.model = arch;
-  impl_->net = IntraRMNet(arch);
-  impl_->net->eval();
-}
-
-IntraRM::~IntraRM() = default;
-IntraRM::IntraRM(IntraRM&&) noexcept = default;
-IntraRM& IntraRM::operator=(IntraRM&&) noexcept = default;
-
-const IntraRMArch& IntraRM::arch() const { return impl_->info.config.model; }
-const IntraRMModelInfo& IntraRM::info() const { return impl_->info; }
-
-void IntraRM::save(const std::string& path) const { saveIntraRMModel(path, *impl_); }
 
 Detections IntraRM::refine(const Detections& input) const {
   input.validate();

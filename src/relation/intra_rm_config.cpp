@@ -3,11 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include <yaml-cpp/yaml.h>
-
 #include "config_sections.h"
-
-#include "ret3d/core/types.h"
 
 namespace ret3d {
 namespace relation {
@@ -36,71 +32,27 @@ void IntraRMTrainConfig::validate() const {
   if (augment_rotation < 0) throw std::invalid_argument("IntraRM train.augment_rotation must be >= 0");
 }
 
+// The keys, in the order toYaml writes them.
+template <class ConfigIO>
+void visitConfig(ConfigIO& io, IntraRMConfig* c) {
+  IntraRMArch& m = c->model;
+  io.section("model", "feature_dim", &m.feature_dim, "hidden", &m.hidden, "rounds", &m.rounds, "radius", &m.radius,
+             "use_edges", &m.use_edges, "head_hidden", &m.head_hidden, "refine_boxes", &m.refine_boxes);
+  IntraRMTrainConfig& t = c->train;
+  io.section("train", "lr", &t.lr, "weight_decay", &t.weight_decay, "frames_per_batch", &t.frames_per_batch,
+             "epochs", &t.epochs, "loc_weight", &t.loc_weight, "dir_weight", &t.dir_weight, "focal_alpha",
+             &t.focal_alpha, "focal_gamma", &t.focal_gamma, "cls_pos_iou", &t.cls_pos_iou, "reg_min_iou",
+             &t.reg_min_iou, "augment_flip", &t.augment_flip, "augment_rotation", &t.augment_rotation, "seed",
+             &t.seed);
+}
+
+template std::string toYaml(const IntraRMConfig& config);
+
 IntraRMConfig parseIntraRMConfig(const std::string& yaml_text, const std::string& source) {
-  return detail::readConfigSections<IntraRMConfig>(
-      "IntraRM", yaml_text, source, [](YamlReader& m, YamlReader& t, IntraRMConfig* c) {
-        m.get("feature_dim", &c->model.feature_dim);
-        m.get("hidden", &c->model.hidden);
-        m.get("rounds", &c->model.rounds);
-        m.get("radius", &c->model.radius);
-        m.get("use_edges", &c->model.use_edges);
-        m.get("head_hidden", &c->model.head_hidden);
-        m.get("refine_boxes", &c->model.refine_boxes);
-        t.get("lr", &c->train.lr);
-        t.get("weight_decay", &c->train.weight_decay);
-        t.get("frames_per_batch", &c->train.frames_per_batch);
-        t.get("epochs", &c->train.epochs);
-        t.get("loc_weight", &c->train.loc_weight);
-        t.get("dir_weight", &c->train.dir_weight);
-        t.get("focal_alpha", &c->train.focal_alpha);
-        t.get("focal_gamma", &c->train.focal_gamma);
-        t.getPerClass("cls_pos_iou", &c->train.cls_pos_iou);
-        t.getPerClass("reg_min_iou", &c->train.reg_min_iou);
-        t.get("augment_flip", &c->train.augment_flip);
-        t.get("augment_rotation", &c->train.augment_rotation);
-        t.get("seed", &c->train.seed);
-      });
+  return detail::readConfig<IntraRMConfig>("IntraRM", yaml_text, source);
 }
 
-IntraRMConfig loadIntraRMConfig(const std::string& path) {
-  return parseIntraRMConfig(readConfigText(path, "IntraRM config " + path), path);
-}
-
-std::string toYaml(const IntraRMConfig& c) {
-  YAML::Emitter e;
-  e << YAML::BeginMap;
-  e << YAML::Key << "model" << YAML::Value << YAML::BeginMap;
-  e << YAML::Key << "feature_dim" << YAML::Value << c.model.feature_dim;
-  e << YAML::Key << "hidden" << YAML::Value << c.model.hidden;
-  e << YAML::Key << "rounds" << YAML::Value << c.model.rounds;
-  e << YAML::Key << "radius" << YAML::Value << c.model.radius;
-  e << YAML::Key << "use_edges" << YAML::Value << c.model.use_edges;
-  e << YAML::Key << "head_hidden" << YAML::Value << c.model.head_hidden;
-  e << YAML::Key << "refine_boxes" << YAML::Value << c.model.refine_boxes;
-  e << YAML::EndMap;
-  auto per_class = [&](const char* key, const PerClass<double>& v) {
-    e << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginMap;
-    for (int k = 0; k < 3; ++k) e << YAML::Key << className(kDetectedClasses[k]) << YAML::Value << v[k];
-    e << YAML::EndMap;
-  };
-  e << YAML::Key << "train" << YAML::Value << YAML::BeginMap;
-  e << YAML::Key << "lr" << YAML::Value << c.train.lr;
-  e << YAML::Key << "weight_decay" << YAML::Value << c.train.weight_decay;
-  e << YAML::Key << "frames_per_batch" << YAML::Value << c.train.frames_per_batch;
-  e << YAML::Key << "epochs" << YAML::Value << c.train.epochs;
-  e << YAML::Key << "loc_weight" << YAML::Value << c.train.loc_weight;
-  e << YAML::Key << "dir_weight" << YAML::Value << c.train.dir_weight;
-  e << YAML::Key << "focal_alpha" << YAML::Value << c.train.focal_alpha;
-  e << YAML::Key << "focal_gamma" << YAML::Value << c.train.focal_gamma;
-  per_class("cls_pos_iou", c.train.cls_pos_iou);
-  per_class("reg_min_iou", c.train.reg_min_iou);
-  e << YAML::Key << "augment_flip" << YAML::Value << c.train.augment_flip;
-  e << YAML::Key << "augment_rotation" << YAML::Value << c.train.augment_rotation;
-  e << YAML::Key << "seed" << YAML::Value << c.train.seed;
-  e << YAML::EndMap;
-  e << YAML::EndMap;
-  return e.c_str();
-}
+IntraRMConfig loadIntraRMConfig(const std::string& path) { return loadConfig(parseIntraRMConfig, "IntraRM", path); }
 
 }  // namespace relation
 }  // namespace ret3d

@@ -2,13 +2,8 @@
 #include "ret3d/relation/intra_rm_learner.h"
 
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 #include <random>
-#include <sstream>
 #include <stdexcept>
-
-#include <yaml-cpp/yaml.h>
 
 #include "intra_rm_network.h"
 #include "learner_checkpoint.h"
@@ -17,94 +12,81 @@
 namespace ret3d {
 namespace relation {
 
-namespace fs = std::filesystem;
+using Learner = IntraRMLearner::Impl;
 
-struct IntraRMLearner::Impl {
-  IntraRMConfig config;
-  IntraRM model;
-  std::unique_ptr<torch::optim::AdamW> optimizer;
-  std::mt19937_64 rng;
-
-  Impl(const IntraRMConfig& c, std::uint64_t seed) : config(c), model(c.model, seed), rng(seed) {
-    model.impl().info.config = c;
-    optimizer = std::make_unique<torch::optim::AdamW>(
-        model.impl().net->parameters(),
-        torch::optim::AdamWOptions(c.train.lr).weight_decay(c.train.weight_decay));
-  }
-
-  IntraRMNet& net() { return model.impl().net; }
-
-  // Loss of eq. (5) over a batch; `targets` aligned with the batch's nodes.
-  std::pair<torch::Tensor, IntraRMLoss> loss(const std::vector<const Detections*>& dets,
-                                             const std::vector<const std::vector<IntraRMTarget>*>& targets) {
-    const IntraRMInputs in = makeIntraRMInputs(dets, config.model);
-    const int64_t n = static_cast<int64_t>(in.nodes);
-    torch::Tensor cls_t = torch::zeros({n, 3}), cls_w = torch::zeros({n, 1}), reg_m = torch::zeros({n});
-    torch::Tensor loc_t = torch::zeros({n, 3}), box_t = torch::zeros({n, 4});
-    auto ct = cls_t.accessor<float, 2>();
-    auto cw = cls_w.accessor<float, 2>();
-    auto rm = reg_m.accessor<float, 1>();
-    auto lt = loc_t.accessor<float, 2>();
-    auto bt = box_t.accessor<float, 2>();
-    int64_t i = 0;
-    double positives = 0;
-    for (const auto* tv : targets) {
-      for (const IntraRMTarget& t : *tv) {
-        for (int k = 0; k < 3; ++k) ct[i][k] = t.cls[k];
-        cw[i][0] = t.cls_weight;
-        positives += (t.cls[0] + t.cls[1] + t.cls[2]) > 0 ? t.cls_weight : 0;
-        if (t.regress) {
-          rm[i] = 1;
-          lt[i][0] = t.dx, lt[i][1] = t.dy, lt[i][2] = t.dz;
-          bt[i][0] = t.dyaw, bt[i][1] = t.dl, bt[i][2] = t.dw, bt[i][3] = t.dh;
-        }
-        ++i;
-      }
-    }
-    const IntraRMOutput out = net()->forward(in.basic, in.feat, in.source, in.target);
-    // Focal loss (Lin et al.), sigmoid per class channel, normalised by the number of positives.
-    const double alpha = config.train.focal_alpha, gamma = config.train.focal_gamma;
-    const torch::Tensor p = torch::sigmoid(out.cls);
-    const torch::Tensor ce = torch::binary_cross_entropy_with_logits(out.cls, cls_t, {}, {}, at::Reduction::None);
-    const torch::Tensor p_t = p * cls_t + (1 - p) * (1 - cls_t);
-    const torch::Tensor a_t = alpha * cls_t + (1 - alpha) * (1 - cls_t);
-    const torch::Tensor l_cls = (a_t * torch::pow(1 - p_t, gamma) * ce * cls_w).sum() / std::max(1.0, positives);
-    // Smooth-L1 on location (centre and log size: the box's place and extent) and on heading, over regressed boxes.
-    const double n_reg = std::max(1.0, reg_m.sum().item<double>());
-    const torch::Tensor m = reg_m.unsqueeze(1);
-    // Both sides in the units of the residuals' spread (IntraRMNetImpl::loc_scale, box_scale).
-    const torch::Tensor ls = net()->loc_scale, bs = net()->box_scale;
-    const torch::Tensor pred_reg = torch::cat({out.loc / ls, (out.box / bs).slice(1, 1, 4)}, 1);
-    const torch::Tensor t_reg = torch::cat({loc_t / ls, (box_t / bs).slice(1, 1, 4)}, 1);
-    const torch::Tensor l_reg =
-        (torch::smooth_l1_loss(pred_reg, t_reg, at::Reduction::None) * m).sum() / n_reg;
-    const torch::Tensor l_dir = (torch::smooth_l1_loss((out.box / bs).slice(1, 0, 1), (box_t / bs).slice(1, 0, 1),
-                                                       at::Reduction::None) *
-                                 m)
-                                    .sum() /
-                                n_reg;
-    const torch::Tensor total = l_cls + config.train.loc_weight * l_reg + config.train.dir_weight * l_dir;
-    IntraRMLoss L;
-    L.total = total.item<double>();
-    L.cls = l_cls.item<double>();
-    L.reg = l_reg.item<double>();
-    L.dir = l_dir.item<double>();
-    L.positives = static_cast<std::size_t>(positives);
-    L.nodes = in.nodes;
-    return {total, L};
-  }
-};
-
-IntraRMLearner::IntraRMLearner(const IntraRMConfig& config, std::uint64_t seed)
-    : impl_(std::make_unique<Impl>(config, seed)) {
-  config.model.validate();
-  config.train.validate();
+std::ostream& operator<<(std::ostream& out, const IntraRMLoss& loss) {
+  return out << "(cls " << loss.cls << " reg " << loss.reg << " dir " << loss.dir << ")";
 }
 
-IntraRMLearner::~IntraRMLearner() = default;
+// refine_boxes only changes what refine() applies: a checkpoint trained either way fits.
+bool sameNetwork(const IntraRMArch& a, const IntraRMArch& b) {
+  return a.feature_dim == b.feature_dim && a.hidden == b.hidden && a.rounds == b.rounds &&
+         a.head_hidden == b.head_hidden && a.radius == b.radius && a.use_edges == b.use_edges;
+}
 
-void IntraRMLearner::fitNormalisation(const std::vector<IntraRMFrame>& frames) {
-  const IntraRMArch& a = impl_->config.model;
+// Loss of eq. (5) over a batch of frames.
+std::pair<torch::Tensor, IntraRMLoss> batchLoss(Learner& learner, const std::vector<const IntraRMFrame*>& batch) {
+  std::vector<const Detections*> dets;
+  for (const IntraRMFrame* f : batch) dets.push_back(&f->detections);
+  const IntraRMInputs in = makeIntraRMInputs(dets, learner.config.model);
+  const int64_t n = static_cast<int64_t>(in.nodes);
+  torch::Tensor cls_t = torch::zeros({n, 3}), cls_w = torch::zeros({n, 1}), reg_m = torch::zeros({n});
+  torch::Tensor loc_t = torch::zeros({n, 3}), box_t = torch::zeros({n, 4});
+  auto ct = cls_t.accessor<float, 2>();
+  auto cw = cls_w.accessor<float, 2>();
+  auto rm = reg_m.accessor<float, 1>();
+  auto lt = loc_t.accessor<float, 2>();
+  auto bt = box_t.accessor<float, 2>();
+  int64_t i = 0;
+  double positives = 0;
+  for (const IntraRMFrame* f : batch) {
+    for (const IntraRMTarget& t : f->targets) {
+      for (int k = 0; k < 3; ++k) ct[i][k] = t.cls[k];
+      cw[i][0] = t.cls_weight;
+      positives += (t.cls[0] + t.cls[1] + t.cls[2]) > 0 ? t.cls_weight : 0;
+      if (t.regress) {
+        rm[i] = 1;
+        lt[i][0] = t.dx, lt[i][1] = t.dy, lt[i][2] = t.dz;
+        bt[i][0] = t.dyaw, bt[i][1] = t.dl, bt[i][2] = t.dw, bt[i][3] = t.dh;
+      }
+      ++i;
+    }
+  }
+  const IntraRMOutput out = learner.net()->forward(in.basic, in.feat, in.source, in.target);
+  // Focal loss (Lin et al.), sigmoid per class channel, normalised by the number of positives.
+  const double alpha = learner.config.train.focal_alpha, gamma = learner.config.train.focal_gamma;
+  const torch::Tensor p = torch::sigmoid(out.cls);
+  const torch::Tensor ce = torch::binary_cross_entropy_with_logits(out.cls, cls_t, {}, {}, at::Reduction::None);
+  const torch::Tensor p_t = p * cls_t + (1 - p) * (1 - cls_t);
+  const torch::Tensor a_t = alpha * cls_t + (1 - alpha) * (1 - cls_t);
+  const torch::Tensor l_cls = (a_t * torch::pow(1 - p_t, gamma) * ce * cls_w).sum() / std::max(1.0, positives);
+  // Smooth-L1 on location (centre and log size: the box's place and extent) and on heading, over regressed boxes.
+  const double n_reg = std::max(1.0, reg_m.sum().item<double>());
+  const torch::Tensor m = reg_m.unsqueeze(1);
+  // Both sides in the units of the residuals' spread (IntraRMNetImpl::loc_scale, box_scale).
+  const torch::Tensor ls = learner.net()->loc_scale, bs = learner.net()->box_scale;
+  const torch::Tensor pred_reg = torch::cat({out.loc / ls, (out.box / bs).slice(1, 1, 4)}, 1);
+  const torch::Tensor t_reg = torch::cat({loc_t / ls, (box_t / bs).slice(1, 1, 4)}, 1);
+  const torch::Tensor l_reg = (torch::smooth_l1_loss(pred_reg, t_reg, at::Reduction::None) * m).sum() / n_reg;
+  const torch::Tensor l_dir = (torch::smooth_l1_loss((out.box / bs).slice(1, 0, 1), (box_t / bs).slice(1, 0, 1),
+                                                     at::Reduction::None) *
+                               m)
+                                  .sum() /
+                              n_reg;
+  const IntraRMTrainConfig& tc = learner.config.train;
+  const torch::Tensor total = l_cls + tc.loc_weight * l_reg + tc.dir_weight * l_dir;
+  IntraRMLoss L;
+  L.total = total.item<double>();
+  L.cls = l_cls.item<double>();
+  L.reg = l_reg.item<double>();
+  L.dir = l_dir.item<double>();
+  L.positives = static_cast<std::size_t>(positives);
+  L.nodes = in.nodes;
+  return {total, L};
+}
+
+void fitInputNormalisation(Learner& learner, const std::vector<IntraRMFrame>& frames) {
+  const IntraRMArch& a = learner.config.model;
   std::vector<double> sum(kIntraBasicFeatures, 0), sq(kIntraBasicFeatures, 0);
   std::vector<double> fsum(a.feature_dim, 0), fsq(a.feature_dim, 0);
   double count = 0;
@@ -136,7 +118,7 @@ void IntraRMLearner::fitNormalisation(const std::vector<IntraRMFrame>& frames) {
     }
   };
   torch::NoGradGuard no_grad;
-  auto& net = impl_->net();
+  auto& net = learner.net();
   std::vector<bool> keep(kIntraBasicFeatures, true);
   for (int k : {6, 7, 11, 12, 13}) keep[static_cast<std::size_t>(k)] = false;
   stats(sum, sq, net->basic_mean, net->basic_std, keep);
@@ -160,62 +142,48 @@ void IntraRMLearner::fitNormalisation(const std::vector<IntraRMFrame>& frames) {
   }
 }
 
-IntraRMLoss IntraRMLearner::step(const std::vector<const IntraRMFrame*>& batch) {
-  const auto& tc = impl_->config.train;
+std::vector<IntraRMFrame> augmented(Learner& learner, const std::vector<const IntraRMFrame*>& batch) {
+  const auto& tc = learner.config.train;
   // Augmentation: one rotation about the sensor's z axis and an optional mirror (y -> -y) per frame, applied to the
   // boxes and to the regression targets alike (size residuals are invariant; centre residuals turn with the frame;
   // the heading residual changes sign under the mirror).
-  std::vector<Detections> dets(batch.size());
-  std::vector<std::vector<IntraRMTarget>> targets(batch.size());
+  std::vector<IntraRMFrame> frames(batch.size());
   std::uniform_real_distribution<double> rot(-tc.augment_rotation, tc.augment_rotation);
   std::bernoulli_distribution flip(0.5);
   for (std::size_t f = 0; f < batch.size(); ++f) {
-    dets[f] = batch[f]->detections;
-    targets[f] = batch[f]->targets;
-    const double th = tc.augment_rotation > 0 ? rot(impl_->rng) : 0.0;
-    const bool mirror = tc.augment_flip && flip(impl_->rng);
+    frames[f] = *batch[f];
+    const double th = tc.augment_rotation > 0 ? rot(learner.rng) : 0.0;
+    const bool mirror = tc.augment_flip && flip(learner.rng);
     const double c = std::cos(th), s = std::sin(th);
     auto turn = [&](double& x, double& y) {
       if (mirror) y = -y;
       const double nx = c * x - s * y, ny = s * x + c * y;
       x = nx, y = ny;
     };
-    for (Box& b : dets[f].boxes) {
+    for (Box& b : frames[f].detections.boxes) {
       turn(b.x, b.y);
       turn(b.vx, b.vy);
       b.yaw = wrapAngle((mirror ? -b.yaw : b.yaw) + th);
     }
-    for (IntraRMTarget& t : targets[f]) {
+    for (IntraRMTarget& t : frames[f].targets) {
       double dx = t.dx, dy = t.dy;
       turn(dx, dy);
       t.dx = static_cast<float>(dx), t.dy = static_cast<float>(dy);
       if (mirror) t.dyaw = -t.dyaw;
     }
   }
-  std::vector<const Detections*> dp;
-  std::vector<const std::vector<IntraRMTarget>*> tp;
-  for (std::size_t f = 0; f < batch.size(); ++f) dp.push_back(&dets[f]), tp.push_back(&targets[f]);
-  impl_->net()->train();
-  auto [total, L] = impl_->loss(dp, tp);
-  impl_->optimizer->zero_grad();
-  total.backward();
-  torch::nn::utils::clip_grad_norm_(impl_->net()->parameters(), 10.0);
-  impl_->optimizer->step();
-  impl_->net()->eval();
-  return L;
+  return frames;
 }
 
-IntraRMLoss IntraRMLearner::evaluate(const std::vector<IntraRMFrame>& frames) const {
-  torch::NoGradGuard no_grad;
+// The mean over batches of frames_per_batch frames.
+IntraRMLoss meanLoss(Learner& learner, const std::vector<IntraRMFrame>& frames) {
   IntraRMLoss sum;
   double batches = 0;
-  const std::size_t bs = static_cast<std::size_t>(impl_->config.train.frames_per_batch);
-  for (std::size_t s = 0; s < frames.size(); s += bs) {
-    std::vector<const Detections*> dp;
-    std::vector<const std::vector<IntraRMTarget>*> tp;
-    for (std::size_t f = s; f < std::min(frames.size(), s + bs); ++f)
-      dp.push_back(&frames[f].detections), tp.push_back(&frames[f].targets);
-    const IntraRMLoss L = impl_->loss(dp, tp).second;
+  const std::size_t bs = static_cast<std::size_t>(learner.config.train.frames_per_batch);
+  for (std::size_t b = 0; b < frames.size(); b += bs) {
+    std::vector<const IntraRMFrame*> batch;
+    for (std::size_t f = b; f < std::min(frames.size(), b + bs); ++f) batch.push_back(&frames[f]);
+    const IntraRMLoss L = batchLoss(learner, batch).second;
     sum.total += L.total, sum.cls += L.cls, sum.reg += L.reg, sum.dir += L.dir;
     sum.positives += L.positives, sum.nodes += L.nodes;
     ++batches;
@@ -224,43 +192,7 @@ IntraRMLoss IntraRMLearner::evaluate(const std::vector<IntraRMFrame>& frames) co
   return sum;
 }
 
-const IntraRM& IntraRMLearner::model() const { return impl_->model; }
-
-IntraRM IntraRMLearner::snapshot() const {
-  IntraRM copy(impl_->config.model);
-  copy.impl().info = impl_->model.info();
-  torch::NoGradGuard no_grad;
-  auto dst_p = copy.impl().net->named_parameters();
-  for (const auto& p : impl_->model.impl().net->named_parameters()) dst_p[p.key()].copy_(p.value());
-  auto dst_b = copy.impl().net->named_buffers();
-  for (const auto& b : impl_->model.impl().net->named_buffers()) dst_b[b.key()].copy_(b.value());
-  return copy;
-}
-
-void IntraRMLearner::setTrainedOn(const std::string& text) { impl_->model.impl().info.trained_on = text; }
-
-void IntraRMLearner::saveCheckpoint(const std::string& dir, int epoch, double best_val) const {
-  fs::create_directories(dir);
-  impl_->model.save(dir + "/model.pt");
-  writeLearnerCheckpoint(dir, *impl_->optimizer, epoch, best_val, impl_->rng);
-}
-
-bool IntraRMLearner::loadCheckpoint(const std::string& dir, int* epoch, double* best_val) {
-  if (!readLearnerState(dir, "IntraRM", epoch, best_val, &impl_->rng)) return false;
-  IntraRMOptions o;
-  o.model_path = dir + "/model.pt";
-  IntraRM saved(o);
-  const IntraRMArch& a = saved.arch();
-  const IntraRMArch& b = impl_->config.model;
-  if (a.feature_dim != b.feature_dim || a.hidden != b.hidden || a.rounds != b.rounds || a.head_hidden != b.head_hidden ||
-      a.radius != b.radius || a.use_edges != b.use_edges)
-    throw std::runtime_error("IntraRM checkpoint " + dir + ": network shape differs from the configuration (" +
-                             toYaml({a, {}}) + ")");
-  copyWeights(*saved.impl().net, *impl_->net());
-  impl_->model.impl().info.trained_on = saved.info().trained_on;
-  readLearnerOptimizer(dir, "IntraRM", impl_->optimizer.get());
-  return true;
-}
+template class RelationLearner<IntraRM, IntraRMFrame, IntraRMLoss>;
 
 }  // namespace relation
 }  // namespace ret3d

@@ -2,11 +2,7 @@
 #include "intra_rm_network.h"
 
 #include <cmath>
-#include <filesystem>
-#include <sstream>
 #include <stdexcept>
-
-#include <yaml-cpp/yaml.h>
 
 #include "ret3d/core/geometry.h"
 #include "ret3d/relation/intra_rm_targets.h"
@@ -152,153 +148,9 @@ Detections applyIntraRMOutput(const Detections& input, const IntraRMOutput& out,
 
 // ---- model file ---------------------------------------------------------------------------------------------------
 
-namespace {
+template class RelationModule<IntraRMImpl, IntraRMConfig>;
 
-const char* kMetaKey = "ret3d_metadata";
-
-std::string metadataYaml(const IntraRMModelInfo& info) {
-  YAML::Node m;
-  m["format"] = kIntraRMFormatName;
-  m["format_version"] = kIntraRMFormatVersion;
-  for (ObjectClass c : kDetectedClasses) m["classes"].push_back(className(c));
-  m["basic_features"] = kIntraBasicFeatures;
-  m["trained_on"] = info.trained_on;
-  m["config"] = YAML::Load(toYaml(info.config));
-  YAML::Emitter e;
-  e << m;
-  return e.c_str();
-}
-
-[[noreturn]] void bad(const std::string& path, const std::string& what) {
-  throw std::runtime_error("IntraRM model " + path + ": " + what);
-}
-
-std::vector<std::pair<std::string, std::vector<int64_t>>> shapes(const IntraRMNet& net) {
-  std::vector<std::pair<std::string, std::vector<int64_t>>> s;
-  for (const auto& p : net->named_parameters()) s.emplace_back(p.key(), p.value().sizes().vec());
-  for (const auto& p : net->named_buffers()) s.emplace_back(p.key(), p.value().sizes().vec());
-  return s;
-}
-
-std::string shapeString(const std::vector<int64_t>& v) {
-  std::string s = "[";
-  for (std::size_t i = 0; i < v.size(); ++i) s += (i ? "x" : "") + std::to_string(v[i]);
-  return s + "]";
-}
-
-}  // namespace
-
-static IntraRMModelInfo parseIntraRMMetadataFields(const std::string& path, const std::string& text) {
-  YAML::Node m;
-  try {
-    m = YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    bad(path, std::string("metadata is not valid YAML: ") + e.what());
-  }
-  if (!m.IsMap() || !m["format"] || m["format"].as<std::string>() != kIntraRMFormatName)
-    bad(path, "not an IntraRM model (metadata format is not '" + std::string(kIntraRMFormatName) + "')");
-  IntraRMModelInfo info;
-  info.format_version = m["format_version"] ? m["format_version"].as<int>() : 0;
-  if (info.format_version != kIntraRMFormatVersion)
-    bad(path, "format version " + std::to_string(info.format_version) + ", this build reads version " +
-                  std::to_string(kIntraRMFormatVersion));
-  std::vector<std::string> classes;
-  if (m["classes"]) classes = m["classes"].as<std::vector<std::string>>();
-  std::vector<std::string> ours;
-  for (ObjectClass c : kDetectedClasses) ours.push_back(className(c));
-  if (classes != ours) {
-    std::string got;
-    for (const auto& c : classes) got += (got.empty() ? "" : ",") + c;
-    bad(path, "trained for classes [" + got + "], this build detects [Car,Pedestrian,Cyclist]");
-  }
-  if (!m["basic_features"] || m["basic_features"].as<int>() != kIntraBasicFeatures)
-    bad(path, "built for another basic-feature layout (basic_features is not " +
-                  std::to_string(kIntraBasicFeatures) + ")");
-  if (m["trained_on"]) info.trained_on = m["trained_on"].as<std::string>();
-  if (!m["config"]) bad(path, "metadata has no config");
-  YAML::Emitter e;
-  e << m["config"];
-  try {
-    info.config = parseIntraRMConfig(e.c_str(), path + " (metadata)");
-  } catch (const std::invalid_argument& err) {
-    bad(path, err.what());
-  }
-  return info;
-}
-
-// A value of the wrong type (yaml-cpp's BadConversion) is refused like any other bad metadata, naming the file.
-static IntraRMModelInfo parseIntraRMMetadata(const std::string& path, const std::string& text) {
-  try {
-    return parseIntraRMMetadataFields(path, text);
-  } catch (const YAML::Exception& e) {
-    bad(path, std::string("unreadable metadata: ") + e.what());
-  }
-}
-
-static torch::serialize::InputArchive openArchive(const std::string& path) {
-  if (!std::filesystem::is_regular_file(path)) bad(path, "no such file");
-  torch::serialize::InputArchive ar;
-  try {
-    ar.load_from(path);
-  } catch (const std::exception& e) {
-    std::string msg = e.what();
-    msg = msg.substr(0, msg.find('\n'));
-    bad(path, "cannot be read as a model archive (truncated or corrupt?): " + msg);
-  }
-  return ar;
-}
-
-static IntraRMModelInfo readInfo(const std::string& path, torch::serialize::InputArchive& ar) {
-  c10::IValue meta;
-  bool ok = false;
-  try {
-    ok = ar.try_read(kMetaKey, meta);
-  } catch (const std::exception&) {
-    ok = false;
-  }
-  if (!ok || !meta.isString()) bad(path, "no IntraRM metadata (not an IntraRM model file)");
-  return parseIntraRMMetadata(path, meta.toStringRef());
-}
-
-IntraRMModelInfo readIntraRMModelInfo(const std::string& path) {
-  auto ar = openArchive(path);
-  return readInfo(path, ar);
-}
-
-void saveIntraRMModel(const std::string& path, const IntraRM::Impl& impl) {
-  const auto parent = std::filesystem::path(path).parent_path();
-  if (!parent.empty()) std::filesystem::create_directories(parent);
-  torch::serialize::OutputArchive ar;
-  impl.net->save(ar);
-  ar.write(kMetaKey, c10::IValue(metadataYaml(impl.info)));
-  // Write to a temporary name and rename, so an interrupted save never leaves a truncated model under `path`.
-  const std::string tmp = path + ".tmp";
-  ar.save_to(tmp);
-  std::filesystem::rename(tmp, path);
-}
-
-void loadIntraRMModel(const std::string& path, IntraRM::Impl* impl) {
-  auto ar = openArchive(path);
-  IntraRMModelInfo info = readInfo(path, ar);
-  IntraRMNet net(info.config.model);
-  const auto expected = shapes(net);
-  try {
-    net->load(ar);
-  } catch (const std::exception& e) {
-    std::string msg = e.what();
-    msg = msg.substr(0, msg.find('\n'));
-    bad(path, "parameters do not fit the metadata's network shape: " + msg);
-  }
-  const auto got = shapes(net);
-  for (std::size_t i = 0; i < expected.size(); ++i) {
-    if (got[i].second != expected[i].second)
-      bad(path, "parameter '" + got[i].first + "' has shape " + shapeString(got[i].second) + ", the metadata's " +
-                    "network needs " + shapeString(expected[i].second));
-  }
-  net->eval();
-  impl->info = std::move(info);
-  impl->net = net;
-}
+IntraRMModelInfo readIntraRMModelInfo(const std::string& path) { return readModuleInfo<IntraRMImpl>(path); }
 
 }  // namespace relation
 }  // namespace ret3d

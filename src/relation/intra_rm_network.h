@@ -7,6 +7,7 @@
 
 #include <torch/torch.h>
 
+#include "model_archive.h"
 #include "ret3d/core/detections.h"
 #include "ret3d/relation/intra_rm.h"
 #include "ret3d/relation/radius_graph.h"
@@ -14,8 +15,6 @@
 namespace ret3d {
 namespace relation {
 
-inline constexpr int kIntraRMFormatVersion = 1;
-inline constexpr const char* kIntraRMFormatName = "ret3d-intra-rm";
 // Output channels: centre residual (3), heading residual (1) + log-size residual (3), class logits (3).
 inline constexpr int kIntraNumClasses = 3;
 
@@ -51,9 +50,9 @@ class IntraRMNetImpl : public torch::nn::Module {
 };
 TORCH_MODULE(IntraRMNet);
 
-struct IntraRM::Impl {
-  IntraRMModelInfo info;
-  IntraRMNet net{nullptr};
+struct IntraRMImpl : ModuleState<IntraRMNet, IntraRMConfig> {
+  inline static const ModelFormat kFormat{"IntraRM", "ret3d-intra-rm", 1, kIntraBasicFeatures, ArchiveLayout::Nested};
+  static constexpr auto parseConfig = &parseIntraRMConfig;
 };
 
 // The inputs of one batch of frames as tensors (frames laid side by side; edges never cross frames).
@@ -65,10 +64,6 @@ IntraRMInputs makeIntraRMInputs(const std::vector<const Detections*>& frames, co
 
 // Applies the predicted scores and (when refine_boxes) residuals to the input boxes.
 Detections applyIntraRMOutput(const Detections& input, const IntraRMOutput& out, bool refine_boxes = true);
-
-// Model file: a torch archive holding the parameters and buffers plus a YAML metadata string.
-void saveIntraRMModel(const std::string& path, const IntraRM::Impl& impl);
-void loadIntraRMModel(const std::string& path, IntraRM::Impl* impl);  // throws std::runtime_error
 
 }  // namespace relation
 }  // namespace ret3d

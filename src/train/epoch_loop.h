@@ -1,12 +1,15 @@
-// The epoch loop IntraRM and InterRM train with (src/train/intra_trainer.cpp, inter_trainer.cpp): a shuffle that
+// The epoch loop IntraRM and InterRM train with (src/train/intra_trainer.cpp, inter_trainer.cpp), and what their
+// trainers do around it (trainRelationModule): a shuffle that
 // depends only on (seed, epoch), so a resumed run sees the same order; mini-batches of pointers into the samples;
 // a progress bar with the losses; after each epoch the validation loss, the model saved when it is the best so far,
 // and a checkpoint. Without validation samples the last epoch's model is saved.
 #pragma once
 
 #include <algorithm>
+#include <chrono>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <numeric>
 #include <random>
@@ -19,6 +22,14 @@
 
 namespace ret3d {
 namespace train {
+
+// A loss's terms as its operator<< writes them (at the stream's default precision, whatever the caller's).
+template <typename Loss>
+std::string terms(const Loss& loss) {
+  std::ostringstream o;
+  o << loss;
+  return o.str();
+}
 
 struct EpochLoopSettings {
   std::string name;         // "IntraRM", "InterRM": bar and log prefix
@@ -33,12 +44,11 @@ struct EpochLoopSettings {
 
 // Learner: step(batch) and evaluate(samples) returning a loss with .total, model().save(path),
 // saveCheckpoint(path, epochs_done, best_val). Report: first_train_loss, last_train_loss, val_losses, best_epoch,
-// epochs_run. `parts` describes a loss's terms for the bar and the log, e.g. "(loc 0.1 size 0.2 yaw 0.3)".
+// epochs_run. A Loss writes its terms to a stream for the bar and the log, e.g. "(loc 0.1 size 0.2 yaw 0.3)".
 // *best_val is the loss to beat (infinity, or the untrained module's) and is updated.
 template <typename Learner, typename Sample, typename Loss, typename Report>
 void runEpochs(const EpochLoopSettings& s, Learner& learner, const std::vector<Sample>& train,
-               const std::vector<Sample>& val, const std::function<std::string(const Loss&)>& parts,
-               double* best_val, Report* report) {
+               const std::vector<Sample>& val, double* best_val, Report* report) {
   const std::size_t bs = std::max<std::size_t>(1, s.batch_size);
   const std::size_t batches = (train.size() + bs - 1) / bs;
   for (int epoch = s.start_epoch; epoch < s.epochs; ++epoch) {
@@ -60,7 +70,7 @@ void runEpochs(const EpochLoopSettings& s, Learner& learner, const std::vector<S
       if (bar) {
         std::ostringstream info;
         info.precision(4);
-        info << "loss " << L.total << " " << parts(L);
+        info << "loss " << L.total << " " << terms(L);
         bar->tick(1, info.str());
       }
     }
@@ -71,7 +81,7 @@ void runEpochs(const EpochLoopSettings& s, Learner& learner, const std::vector<S
     if (!val.empty()) {
       const Loss V = learner.evaluate(val);
       report->val_losses.push_back(V.total);
-      msg << ", validation loss " << V.total << " " << parts(V);
+      msg << ", validation loss " << V.total << " " << terms(V);
       if (V.total < *best_val) {
         *best_val = V.total;
         report->best_epoch = epoch + 1;
@@ -87,6 +97,44 @@ void runEpochs(const EpochLoopSettings& s, Learner& learner, const std::vector<S
     learner.model().save(s.out_path);
     report->best_epoch = report->epochs_run;
   }
+}
+
+// A relation module's training from its trainer's options (config, out_path, checkpoint_dir, resume, trained_on,
+// progress): the learner started fresh with its input normalisation fitted on `train`, or with options.resume from
+// its checkpoint (default folder: out_path + ".ckpt"), then the epochs. before_loop(learner, start_epoch, &best_val)
+// runs in between (InterRM: the untrained module's validation loss as the bar to beat). Sets the report's losses,
+// epochs, best_val_loss and seconds (of the epochs).
+template <typename Learner, typename Sample, typename Options, typename Report>
+void trainRelationModule(const std::string& name, const Options& options, int batch_size,
+                         const std::vector<Sample>& train, const std::vector<Sample>& val, Report* report,
+                         const std::function<void(Learner&, int, double*)>& before_loop = {}) {
+  if (options.out_path.empty()) throw std::runtime_error(name + " training: no output model path");
+  const std::string ckpt = options.checkpoint_dir.empty() ? options.out_path + ".ckpt" : options.checkpoint_dir;
+  Learner learner(options.config, options.config.train.seed);
+  learner.setTrainedOn(options.trained_on);
+  int start_epoch = 0;
+  double best_val = std::numeric_limits<double>::infinity();
+  if (options.resume && learner.loadCheckpoint(ckpt, &start_epoch, &best_val)) {
+    RET3D_INFO(name << ": resuming from " << ckpt << " after epoch " << start_epoch);
+    learner.setTrainedOn(options.trained_on);
+  } else {
+    learner.fitNormalisation(train);
+  }
+  if (before_loop) before_loop(learner, start_epoch, &best_val);
+  const auto t0 = std::chrono::steady_clock::now();
+  EpochLoopSettings loop;
+  loop.name = name;
+  loop.start_epoch = start_epoch;
+  loop.epochs = options.config.train.epochs;
+  loop.seed = options.config.train.seed;
+  loop.batch_size = static_cast<std::size_t>(batch_size);
+  loop.out_path = options.out_path;
+  loop.checkpoint = ckpt;
+  loop.progress = options.progress;
+  using Loss = decltype(learner.evaluate(val));
+  runEpochs<Learner, Sample, Loss>(loop, learner, train, val, &best_val, report);
+  report->best_val_loss = best_val;
+  report->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 }  // namespace train

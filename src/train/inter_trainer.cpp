@@ -111,57 +111,26 @@ std::vector<InterRMSample> loadInterSamples(const InterDataOptions& data, const 
 InterTrainReport trainInterRM(const std::vector<InterRMSample>& train, const std::vector<InterRMSample>& val,
                               const InterTrainOptions& options) {
   if (train.empty()) throw std::runtime_error("InterRM training: no training sequences");
-  if (options.out_path.empty()) throw std::runtime_error("InterRM training: no output model path");
-  const relation::InterRMConfig& cfg = options.config;
-  const std::string ckpt = options.checkpoint_dir.empty() ? options.out_path + ".ckpt" : options.checkpoint_dir;
   InterTrainReport report;
   report.train_sequences = train.size();
   report.val_sequences = val.size();
-
-  relation::InterRMLearner learner(cfg, cfg.train.seed);
-  learner.setTrainedOn(options.trained_on);
-  int start_epoch = 0;
-  double best_val = std::numeric_limits<double>::infinity();
-  if (options.resume && learner.loadCheckpoint(ckpt, &start_epoch, &best_val)) {
-    RET3D_INFO("InterRM: resuming from " << ckpt << " after epoch " << start_epoch);
-    learner.setTrainedOn(options.trained_on);
-  } else {
-    learner.fitNormalisation(train);
-  }
-  if (!val.empty() && start_epoch == 0) {
-    // The untrained module is the identity: its loss is that of the input boxes, the bar to beat.
+  // The untrained module is the identity: its loss is that of the input boxes, the bar to beat.
+  const auto identity_loss = [&](relation::InterRMLearner& learner, int start_epoch, double* best_val) {
+    if (val.empty() || start_epoch > 0) return;
     const relation::InterRMLoss V0 = learner.evaluate(val);
     report.initial_val_loss = V0.total;
-    best_val = report.initial_val_loss;
+    *best_val = report.initial_val_loss;
     // Written now, so that if no epoch beats the input boxes the model file is the identity, never a worse module.
     learner.model().save(options.out_path);
     report.best_epoch = 0;
-    RET3D_INFO("InterRM: validation loss of the input boxes (identity) " << V0.total << " (loc " << V0.loc << " size "
-                                                                         << V0.size << " yaw " << V0.yaw << ")");
-  }
-  const auto t0 = std::chrono::steady_clock::now();
-  EpochLoopSettings loop;
-  loop.name = "InterRM";
-  loop.start_epoch = start_epoch;
-  loop.epochs = cfg.train.epochs;
-  loop.seed = cfg.train.seed;
-  loop.batch_size = static_cast<std::size_t>(cfg.train.sequences_per_batch);
-  loop.out_path = options.out_path;
-  loop.checkpoint = ckpt;
-  loop.progress = options.progress;
-  const std::function<std::string(const relation::InterRMLoss&)> parts = [](const relation::InterRMLoss& L) {
-    std::ostringstream o;
-    o << "(loc " << L.loc << " size " << L.size << " yaw " << L.yaw << ")";
-    return o.str();
+    RET3D_INFO("InterRM: validation loss of the input boxes (identity) " << V0.total << " " << V0);
   };
-  runEpochs<relation::InterRMLearner, InterRMSample, relation::InterRMLoss>(loop, learner, train, val, parts,
-                                                           &best_val, &report);
+  trainRelationModule<relation::InterRMLearner>("InterRM", options, options.config.train.sequences_per_batch, train,
+                                                val, &report, identity_loss);
   if (!val.empty() && report.best_epoch == 0) {
     RET3D_WARN("InterRM: no epoch improved on the input boxes' validation loss; " << options.out_path
                                                                                   << " is the identity module");
   }
-  report.best_val_loss = best_val;
-  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return report;
 }
 

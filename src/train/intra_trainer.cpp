@@ -142,46 +142,13 @@ std::vector<IntraRMFrame> loadIntraFrames(const std::string& data_dir, const io:
 
 IntraTrainReport trainIntraRM(const std::vector<IntraRMFrame>& train, const std::vector<IntraRMFrame>& val,
                               const IntraTrainOptions& options) {
-  namespace fs = std::filesystem;
-  if (train.empty()) throw std::runtime_error("IntraRM training: no training frames with detections");
-  if (options.out_path.empty()) throw std::runtime_error("IntraRM training: no output model path");
-  const relation::IntraRMConfig& cfg = options.config;
-  const std::string ckpt = options.checkpoint_dir.empty() ? options.out_path + ".ckpt" : options.checkpoint_dir;
   IntraTrainReport report;
+  for (const auto& f : train) report.train_boxes += f.detections.size();
   report.train_frames = train.size();
   report.val_frames = val.size();
-  for (const auto& f : train) report.train_boxes += f.detections.size();
-
-  relation::IntraRMLearner learner(cfg, cfg.train.seed);
-  learner.setTrainedOn(options.trained_on);
-  int start_epoch = 0;
-  double best_val = std::numeric_limits<double>::infinity();
-  if (options.resume && learner.loadCheckpoint(ckpt, &start_epoch, &best_val)) {
-    RET3D_INFO("IntraRM: resuming from " << ckpt << " after epoch " << start_epoch);
-    learner.setTrainedOn(options.trained_on);
-  } else {
-    learner.fitNormalisation(train);
-  }
-  const auto t0 = std::chrono::steady_clock::now();
-  EpochLoopSettings loop;
-  loop.name = "IntraRM";
-  loop.start_epoch = start_epoch;
-  loop.epochs = cfg.train.epochs;
-  loop.seed = cfg.train.seed;
-  loop.batch_size = static_cast<std::size_t>(cfg.train.frames_per_batch);
-  loop.out_path = options.out_path;
-  loop.checkpoint = ckpt;
-  loop.progress = options.progress;
-  const std::function<std::string(const relation::IntraRMLoss&)> parts = [](const relation::IntraRMLoss& L) {
-    std::ostringstream o;
-    o << "(cls " << L.cls << " reg " << L.reg << " dir " << L.dir << ")";
-    return o.str();
-  };
-  runEpochs<relation::IntraRMLearner, IntraRMFrame, relation::IntraRMLoss>(loop, learner, train, val, parts,
-                                                          &best_val, &report);
-
-  report.best_val_loss = best_val;
-  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (train.empty()) throw std::runtime_error("IntraRM training: no training frames with detections");
+  trainRelationModule<relation::IntraRMLearner>("IntraRM", options, options.config.train.frames_per_batch, train, val,
+                                                &report);
   return report;
 }
 

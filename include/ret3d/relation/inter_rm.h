@@ -24,9 +24,12 @@
 
 #include "ret3d/core/per_class.h"
 #include "ret3d/core/types.h"
+#include "ret3d/relation/relation_module.h"
 
 namespace ret3d {
 namespace relation {
+
+struct InterRMImpl;  // the torch side: src/relation/inter_rm_network.h
 
 // Table 4's positional encodings. All of them keep dt as an input feature (the implicit encoding); temporal and
 // spatial add sinusoids to D on top ("++Temporal", "++Spatial").
@@ -48,10 +51,10 @@ struct InterRMArch {
 };
 
 struct InterRMTrainConfig {
+  int epochs = 8;
+  int sequences_per_batch = 64;
   double lr = 3e-4;  // AdamW, as the paper
   double weight_decay = 0.01;
-  int sequences_per_batch = 64;
-  int epochs = 8;
   double smooth_l1_beta = 0.1;  // smooth-L1 transition point (residual units: m, log-ratio, rad)
   // The current box is regressed towards its class-aware best BEV-IoU ground truth when the IoU reaches this
   // (Car, Pedestrian, Cyclist): the assignment IntraRM uses.
@@ -62,16 +65,12 @@ struct InterRMTrainConfig {
   void validate() const;
 };
 
-struct InterRMConfig {
-  InterRMArch model;
-  InterRMTrainConfig train;
-};
+using InterRMConfig = RelationConfig<InterRMArch, InterRMTrainConfig>;
 
 // Reads a YAML file with optional sections `model:` and `train:`; missing keys keep their defaults; unknown keys and
 // bad values throw std::invalid_argument naming them (a missing/unparsable file: std::runtime_error).
 InterRMConfig loadInterRMConfig(const std::string& path);
 InterRMConfig parseInterRMConfig(const std::string& yaml_text, const std::string& source = "<string>");
-std::string toYaml(const InterRMConfig& config);
 
 // One track's sequence S_i, in the current sensor frame, NEWEST FIRST: boxes[0] is the current (tracked) box, the
 // others its past boxes; dt[k] is the time of entry k minus now (s, dt[0] = 0, decreasing).
@@ -82,47 +81,23 @@ struct InterRMSequence {
 
 struct InterRMOptions {
   std::string model_path;  // a model file written by `ret3d train inter` (or InterRM::save)
+  int threads = 0;         // > 0: torch::set_num_threads(threads) when the module is created
   // Optional expectations checked against the model file (a mismatch is refused, saying what differs):
-  int c_enc = -1;                  // < 0: any
-  std::string positional_encoding; // empty: any; else "implicit", "temporal" or "spatial"
-  int threads = 0;                 // > 0: torch::set_num_threads(threads) when the module is created
+  int c_enc = -1;                   // < 0: any
+  std::string positional_encoding;  // empty: any; else "implicit", "temporal" or "spatial"
 };
 
-struct InterRMModelInfo {
-  int format_version = 0;
-  InterRMConfig config;    // the configuration the model was trained with (config.model = its shape)
-  std::string trained_on;  // free text: data and command
-};
-
-class InterRM {
+class InterRM : public RelationModule<InterRMImpl, InterRMConfig> {
  public:
-  // Loads options.model_path; throws std::runtime_error saying what is wrong with the file (missing, truncated, not an
-  // InterRM model, another format version or feature layout, other classes, parameters that do not fit the metadata,
-  // or an expectation of `options` it does not meet).
+  // Loads options.model_path (errors: RelationModule's, or an expectation of `options` the file does not meet).
   explicit InterRM(const InterRMOptions& options);
-  // An untrained module (random weights from `seed`; the regression layer starts at zero: refinement = identity).
-  explicit InterRM(const InterRMArch& arch, std::uint64_t seed = 1);
-  ~InterRM();
-  InterRM(InterRM&&) noexcept;
-  InterRM& operator=(InterRM&&) noexcept;
+  explicit InterRM(const InterRMArch& arch, std::uint64_t seed = 1) : RelationModule(arch, seed) {}
 
   // Refines the current box of every sequence; returns one box per sequence: boxes[0] with refined centre, heading
-  // and (arch().regress_size) size (residuals; the heading residual is within [-pi/2, pi/2)), everything else (score, label, velocity, track
-  // id, point count) kept. Throws std::invalid_argument for an empty sequence, dt of another length, or non-finite
-  // fields.
+  // and (arch().regress_size) size (residuals; the heading residual is within [-pi/2, pi/2)), everything else (score,
+  // label, velocity, track id, point count) kept. Throws std::invalid_argument for an empty sequence, dt of another
+  // length, or non-finite fields.
   std::vector<Box> refine(const std::vector<InterRMSequence>& sequences) const;
-
-  const InterRMArch& arch() const;
-  const InterRMModelInfo& info() const;
-  void save(const std::string& path) const;
-
-  // For the training code: the implementation, torch types included (src/relation/inter_rm_network.h).
-  struct Impl;
-  Impl& impl() { return *impl_; }
-  const Impl& impl() const { return *impl_; }
-
- private:
-  std::unique_ptr<Impl> impl_;
 };
 
 // Per-entry basic features (see the top of this file), in network order.
@@ -130,6 +105,7 @@ inline constexpr int kInterBasicFeatures = 16;
 // Entry `k` of `seq` in the frame of seq.boxes[0].
 void interBasicFeatures(const InterRMSequence& seq, std::size_t k, float* out);
 
+using InterRMModelInfo = ModelInfo<InterRMConfig>;
 // Reads only the metadata of a model file (same checks as the constructor, without building the network).
 InterRMModelInfo readInterRMModelInfo(const std::string& path);
 

@@ -21,50 +21,26 @@
 namespace ret3d {
 namespace relation {
 
+struct IntraRMImpl;  // the torch side: src/relation/intra_rm_network.h
+
 struct IntraRMOptions {
   std::string model_path;  // a model file written by `ret3d train intra` (or IntraRM::save)
+  int threads = 0;         // > 0: torch::set_num_threads(threads) when the module is created
   // Optional expectations checked against the model file (a mismatch is refused, saying what differs):
   double radius = -1;       // < 0: the radius the model was trained with
   int rounds = -1;          // < 0: any
   long feature_dim = -1;    // < 0: any
-  int threads = 0;          // > 0: torch::set_num_threads(threads) when the module is created
 };
 
-// The model file's metadata (also its YAML header, readable with `ret3d train intra --inspect`).
-struct IntraRMModelInfo {
-  int format_version = 0;
-  IntraRMConfig config;     // the configuration the model was trained with (config.model = its shape)
-  std::string trained_on;   // free text: data and command
-};
-
-class IntraRM {
+class IntraRM : public RelationModule<IntraRMImpl, IntraRMConfig> {
  public:
-  // Loads options.model_path; throws std::runtime_error saying what is wrong with the file (missing, truncated, not
-  // an IntraRM model, another format version, other classes, parameters that don't fit the metadata, or an
-  // expectation of `options` it does not meet).
+  // Loads options.model_path (errors: RelationModule's, or an expectation of `options` the file does not meet).
   explicit IntraRM(const IntraRMOptions& options);
-  // An untrained module of the given shape (random weights from `seed`; refinement starts as the identity on boxes).
-  explicit IntraRM(const IntraRMArch& arch, std::uint64_t seed = 1);
-  ~IntraRM();
-  IntraRM(IntraRM&&) noexcept;
-  IntraRM& operator=(IntraRM&&) noexcept;
+  explicit IntraRM(const IntraRMArch& arch, std::uint64_t seed = 1) : RelationModule(arch, seed) {}
 
   // Refines one frame. Throws std::invalid_argument when the input's feature_dim differs from the model's (in
   // particular a model trained with detector features refuses featureless detections).
   Detections refine(const Detections& input) const;
-
-  const IntraRMArch& arch() const;
-  const IntraRMModelInfo& info() const;
-  // Writes the model file (parameters, normalisation, metadata).
-  void save(const std::string& path) const;
-
-  // For the training code (relation/intra_rm_learner.h): the implementation, torch types included.
-  struct Impl;
-  Impl& impl() { return *impl_; }
-  const Impl& impl() const { return *impl_; }
-
- private:
-  std::unique_ptr<Impl> impl_;
 };
 
 // The 14 basic features d_i of a box, in network order (before normalisation):
@@ -72,9 +48,7 @@ class IntraRM {
 inline constexpr int kIntraBasicFeatures = 14;
 void basicFeatures(const Box& box, float* out);
 
-// Sets the number of CPU threads libtorch uses, process-wide (the learned stages share them).
-void setTorchThreads(int threads);
-
+using IntraRMModelInfo = ModelInfo<IntraRMConfig>;
 // Reads only the metadata of a model file (same checks as the constructor, without building the network).
 IntraRMModelInfo readIntraRMModelInfo(const std::string& path);
 

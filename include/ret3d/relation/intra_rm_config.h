@@ -7,6 +7,7 @@
 #include <string>
 
 #include "ret3d/core/per_class.h"
+#include "ret3d/relation/relation_module.h"
 
 namespace ret3d {
 namespace relation {
@@ -48,17 +49,12 @@ struct IntraRMTrainConfig {
   void validate() const;
 };
 
-struct IntraRMConfig {
-  IntraRMArch model;
-  IntraRMTrainConfig train;
-};
+using IntraRMConfig = RelationConfig<IntraRMArch, IntraRMTrainConfig>;
 
-// Reads a YAML file with optional sections `model:` and `train:`; missing keys keep their defaults.
+// Reads a YAML file with optional sections `model:` and `train:`; missing keys keep their defaults (toYaml writes it).
 IntraRMConfig loadIntraRMConfig(const std::string& path);
 // Parses YAML text (`source` names it in error messages).
 IntraRMConfig parseIntraRMConfig(const std::string& yaml_text, const std::string& source = "<string>");
-// The configuration as YAML text, which parseIntraRMConfig reads back.
-std::string toYaml(const IntraRMConfig& config);
 
 }  // namespace relation
 }  // namespace ret3d
