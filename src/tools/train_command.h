@@ -51,6 +51,21 @@ struct RelationTrainArgs {
   // Throws std::runtime_error unless --data and --out are given with exactly one source of boxes.
   void validate() const;
 
+  // The closing lines of a training run: epochs, time, losses, the model file. A Report has epochs_run, seconds,
+  // first_train_loss, last_train_loss, best_val_loss and best_epoch; input_val_loss >= 0 is the validation loss of the
+  // boxes as they came in.
+  template <class Report>
+  void printSummary(const std::string& what, const Report& r, bool validated, double input_val_loss = -1) const {
+    std::cout << what << " trained: " << r.epochs_run << " epochs in " << r.seconds << " s; train loss "
+              << r.first_train_loss << " -> " << r.last_train_loss;
+    if (validated && input_val_loss >= 0)
+      std::cout << "; validation loss " << input_val_loss << " (input boxes) -> best " << r.best_val_loss;
+    else if (validated)
+      std::cout << "; best validation loss " << r.best_val_loss;
+    if (validated) std::cout << " (epoch " << r.best_epoch << ")";
+    std::cout << "\nmodel: " << out << std::endl;
+  }
+
   // --inspect: prints a relation model file's metadata (`what`: "IntraRM", "InterRM"); Info has format_version,
   // trained_on and a config that its namespace's toYaml prints.
   template <class Info>

@@ -57,12 +57,7 @@ int runTrainInter(const TrainInterArgs& a) {
   RET3D_INFO("InterRM: " << train_samples.size() << " training sequences (mean length " << mean_len << "), "
                          << val_samples.size() << " validation sequences");
   const train::InterTrainReport r = train::trainInterRM(train_samples, val_samples, opt);
-  std::cout << "InterRM trained: " << r.epochs_run << " epochs in " << r.seconds << " s; train loss "
-            << r.first_train_loss << " -> " << r.last_train_loss;
-  if (!val_samples.empty())
-    std::cout << "; validation loss " << r.initial_val_loss << " (input boxes) -> best " << r.best_val_loss
-              << " (epoch " << r.best_epoch << ")";
-  std::cout << "\nmodel: " << a.out << std::endl;
+  a.printSummary("InterRM", r, !val_samples.empty(), r.initial_val_loss);
   return 0;
 }
 

@@ -51,10 +51,7 @@ int runTrainIntra(const TrainIntraArgs& a) {
   RET3D_INFO("IntraRM: " << train_frames.size() << " training frames (" << boxes << " detections, " << pos
                          << " positives), " << val_frames.size() << " validation frames");
   const train::IntraTrainReport r = train::trainIntraRM(train_frames, val_frames, opt);
-  std::cout << "IntraRM trained: " << r.epochs_run << " epochs in " << r.seconds << " s; train loss "
-            << r.first_train_loss << " -> " << r.last_train_loss;
-  if (!val_frames.empty()) std::cout << "; best validation loss " << r.best_val_loss << " (epoch " << r.best_epoch << ")";
-  std::cout << "\nmodel: " << a.out << std::endl;
+  a.printSummary("IntraRM", r, !val_frames.empty());
   return 0;
 }
 
