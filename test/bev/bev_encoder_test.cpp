@@ -9,7 +9,7 @@
 
 #include <gtest/gtest.h>
 
-#include "test_util.h"
+#include "support/test_util.h"
 
 namespace ret3d {
 namespace {

@@ -7,21 +7,12 @@
 #include <random>
 
 #include "ret3d/core/transform.h"
+#include "support/boxes.h"
 
 namespace ret3d {
 namespace {
 
-Box makeBox(double x, double y, double z, double l, double w, double h, double yaw) {
-  Box b;
-  b.x = x;
-  b.y = y;
-  b.z = z;
-  b.length = l;
-  b.width = w;
-  b.height = h;
-  b.yaw = yaw;
-  return b;
-}
+using test::makeBox;
 
 TEST(WrapAngle, MapsIntoHalfOpenInterval) {
   EXPECT_NEAR(wrapAngle(0.0), 0.0, 1e-12);

@@ -4,16 +4,13 @@
 
 #include <gtest/gtest.h>
 
+#include "support/boxes.h"
+
 namespace ret3d {
 namespace {
 
 void expectSameBox(const Box& a, const Box& b) {
-  EXPECT_NEAR(a.x, b.x, 1e-4);
-  EXPECT_NEAR(a.y, b.y, 1e-4);
-  EXPECT_NEAR(a.z, b.z, 1e-4);
-  EXPECT_NEAR(a.length, b.length, 1e-4);
-  EXPECT_NEAR(a.width, b.width, 1e-4);
-  EXPECT_NEAR(a.height, b.height, 1e-4);
+  test::expectSameCentreAndSize(a, b, 1e-4);
   EXPECT_NEAR(std::remainder(a.yaw - b.yaw, 2 * M_PI), 0.0, 1e-5);
   EXPECT_NEAR(a.vx, b.vx, 1e-4);
   EXPECT_NEAR(a.vy, b.vy, 1e-4);

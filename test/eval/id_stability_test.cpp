@@ -4,17 +4,15 @@
 
 #include <stdexcept>
 
+#include "support/boxes.h"
+#include "support/error_message.h"
+
 namespace ret3d {
 namespace eval {
 namespace {
 
 Box box(double x, double y, std::uint32_t id, ObjectClass cls = ObjectClass::Car) {
-  Box b;
-  b.x = x;
-  b.y = y;
-  b.length = 4;
-  b.width = 1.8;
-  b.height = 1.5;
+  Box b = test::carBox(x, y);
   b.label = cls;
   b.track_id = id;
   return b;
@@ -150,12 +148,8 @@ TEST(IdStability, IdsArePerSequenceAndClassesPoolByTrackFrames) {
 TEST(IdStability, GroundTruthWithoutIdIsRejected) {
   auto frames = groundTruth(2);
   frames[1].gt_boxes[0].track_id = 0;
-  try {
-    evaluateIdStability(frames);
-    FAIL() << "no exception";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("frame 1"), std::string::npos) << e.what();
-  }
+  const std::string msg = test::errorMessage<std::invalid_argument>([&] { evaluateIdStability(frames); });
+  EXPECT_NE(msg.find("frame 1"), std::string::npos) << msg;
   IdStabilityOptions bad;
   bad.max_center_distance = 0;
   EXPECT_THROW(evaluateIdStability(groundTruth(2), bad), std::invalid_argument);

@@ -6,7 +6,7 @@
 #include <cmath>
 
 #include "ret3d/eval/eval_data.h"
-#include "test_util.h"
+#include "support/test_util.h"
 
 namespace ret3d {
 namespace eval {

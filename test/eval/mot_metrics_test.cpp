@@ -5,21 +5,15 @@
 #include <cmath>
 #include <map>
 
-#include "test_util.h"
+#include "support/boxes.h"
+#include "support/test_util.h"
 
 namespace ret3d {
 namespace eval {
 namespace {
 
 Box car(double x, double y, std::uint32_t id) {
-  Box b;
-  b.x = x;
-  b.y = y;
-  b.z = 0;
-  b.length = 4;
-  b.width = 1.8;
-  b.height = 1.5;
-  b.label = ObjectClass::Car;
+  Box b = test::carBox(x, y);
   b.track_id = id;
   return b;
 }

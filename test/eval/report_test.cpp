@@ -6,7 +6,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "test_util.h"
+#include "support/boxes.h"
+#include "support/test_util.h"
 
 namespace ret3d {
 namespace eval {
@@ -20,12 +21,7 @@ std::string readAll(const std::string& path) {
 }
 
 Box car(double x, std::uint32_t id) {
-  Box b;
-  b.x = x;
-  b.length = 4;
-  b.width = 1.8;
-  b.height = 1.5;
-  b.label = ObjectClass::Car;
+  Box b = test::carBox(x, 0.0);
   b.track_id = id;
   b.num_points = 50;
   return b;

@@ -5,20 +5,15 @@
 #include <cmath>
 
 #include "ret3d/core/geometry.h"
+#include "support/boxes.h"
 
 namespace ret3d {
 namespace eval {
 namespace {
 
 Box car(double x, double y, std::uint32_t points, float score = 1.0f, double yaw = 0.3) {
-  Box b;
-  b.x = x;
-  b.y = y;
-  b.length = 4;
-  b.width = 1.8;
-  b.height = 1.5;
+  Box b = test::carBox(x, y);
   b.yaw = yaw;
-  b.label = ObjectClass::Car;
   b.num_points = points;
   b.score = score;
   return b;

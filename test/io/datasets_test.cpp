@@ -5,7 +5,7 @@
 #include <fstream>
 
 #include "ret3d/io/kitti.h"
-#include "test_util.h"
+#include "support/test_util.h"
 
 namespace ret3d {
 namespace {

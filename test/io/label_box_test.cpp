@@ -8,7 +8,7 @@
 
 #include "ret3d/core/geometry.h"
 #include "ret3d/io/kitti.h"
-#include "test_util.h"
+#include "support/test_util.h"
 
 namespace ret3d {
 namespace {

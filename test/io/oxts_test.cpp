@@ -4,8 +4,8 @@
 #include <fstream>
 
 #include "ret3d/io/kitti.h"
-#include "parse_error_message.h"
-#include "test_util.h"
+#include "support/parse_error_message.h"
+#include "support/test_util.h"
 
 namespace ret3d {
 namespace {

@@ -11,7 +11,8 @@
 #include <gtest/gtest.h>
 
 #include "ret3d/tracking/tracker_options.h"
-#include "test_util.h"
+#include "support/error_message.h"
+#include "support/test_util.h"
 
 namespace ret3d {
 namespace pipeline {
@@ -40,12 +41,8 @@ TEST(TrackerDefault, ExternalDetectionsKeepTheBuiltInValues) {
 }
 
 TEST(TrackerDefault, AMissingPackageIsAClearError) {
-  try {
-    defaultTrackerConfig({"base", "track"}, "");
-    FAIL() << "no error without the package";
-  } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("--tracker-config"), std::string::npos) << e.what();
-  }
+  const std::string msg = test::errorMessage([&] { defaultTrackerConfig({"base", "track"}, ""); });
+  EXPECT_NE(msg.find("--tracker-config"), std::string::npos) << msg;
   test::TempDir tmp;
   try {
     defaultTrackerConfig({"base", "track"}, tmp.path());
@@ -67,12 +64,8 @@ TEST(TrackerDefault, TheDetectorFeedsTheTrackerFromTheNodeletsThreshold) {
   std::ofstream(tmp / "config/ret3d.yaml") << "ret3d_detector:\n  nms_iou: 0.1\n";
   EXPECT_DOUBLE_EQ(pipelineDetectorThreshold(tmp.path(), 0.5), 0.5);  // no key
   std::ofstream(tmp / "config/ret3d.yaml") << "ret3d_detector:\n  score_threshold: 1.5\n";
-  try {
-    pipelineDetectorThreshold(tmp.path(), 0.5);
-    FAIL() << "an out-of-range threshold was accepted";
-  } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("score_threshold"), std::string::npos) << e.what();
-  }
+  const std::string msg = test::errorMessage([&] { pipelineDetectorThreshold(tmp.path(), 0.5); });
+  EXPECT_NE(msg.find("score_threshold"), std::string::npos) << msg;
 }
 
 }  // namespace

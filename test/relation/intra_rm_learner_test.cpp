@@ -4,8 +4,8 @@
 
 #include <gtest/gtest.h>
 
-#include "relation/intra_rm_scenes.h"
-#include "test_util.h"
+#include "support/intra_rm_scenes.h"
+#include "support/test_util.h"
 
 namespace ret3d {
 namespace relation {

@@ -9,9 +9,11 @@
 
 #include <gtest/gtest.h>
 
-#include "relation/intra_rm_scenes.h"
 #include "ret3d/relation/intra_rm_learner.h"
-#include "test_util.h"
+#include "support/boxes.h"
+#include "support/error_message.h"
+#include "support/intra_rm_scenes.h"
+#include "support/test_util.h"
 
 namespace ret3d {
 namespace relation {
@@ -41,12 +43,7 @@ const IntraRM& trainedModule(std::size_t feature_dim = 0) {
 }
 
 void expectBoxNear(const Box& a, const Box& b, double tol = 1e-4) {
-  EXPECT_NEAR(a.x, b.x, tol);
-  EXPECT_NEAR(a.y, b.y, tol);
-  EXPECT_NEAR(a.z, b.z, tol);
-  EXPECT_NEAR(a.length, b.length, tol);
-  EXPECT_NEAR(a.width, b.width, tol);
-  EXPECT_NEAR(a.height, b.height, tol);
+  ret3d::test::expectSameCentreAndSize(a, b, tol);
   EXPECT_NEAR(a.yaw, b.yaw, tol);
   EXPECT_NEAR(a.score, b.score, tol);
   EXPECT_EQ(a.label, b.label);
@@ -134,13 +131,8 @@ TEST(IntraRM, ModelTrainedWithFeaturesRefusesFeaturelessInput) {
   const IntraRM& m = trainedModule(4);
   std::mt19937 rng(2);
   Detections d = test::randomFrame(rng, 5).detections;  // feature_dim 0
-  try {
-    m.refine(d);
-    FAIL() << "featureless detections accepted by a model trained with features";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("trained with detector features (feature_dim 4)"), std::string::npos)
-        << e.what();
-  }
+  const std::string msg = ret3d::test::errorMessage<std::invalid_argument>([&] { m.refine(d); });
+  EXPECT_NE(msg.find("trained with detector features (feature_dim 4)"), std::string::npos) << msg;
   Detections wrong = test::randomFrame(rng, 5, 3).detections;
   EXPECT_THROW(m.refine(wrong), std::invalid_argument);
   // A featureless model refines any detector's boxes, ignoring features they may carry.

@@ -9,13 +9,13 @@
 #include <string>
 #include <vector>
 
-#include "nodes/pipeline_test_util.h"
 #include "ret3d/detector/detector_options.h"
 #include "ret3d/io/kitti.h"
 #include "ret3d/train/detector_dataset.h"
-#include "ros/tiny_models.h"
-#include "ros/tiny_sequence.h"
-#include "test_util.h"
+#include "support/ros_test_util.h"
+#include "support/test_util.h"
+#include "support/tiny_models.h"
+#include "support/tiny_sequence.h"
 
 namespace ret3d {
 namespace {

@@ -11,11 +11,11 @@
 #include <string>
 #include <vector>
 
-#include "nodes/pipeline_test_util.h"
 #include "ret3d/ros/kitti_bag.h"
-#include "ros/tiny_models.h"
-#include "ros/tiny_sequence.h"
-#include "test_util.h"
+#include "support/ros_test_util.h"
+#include "support/test_util.h"
+#include "support/tiny_models.h"
+#include "support/tiny_sequence.h"
 
 namespace ret3d {
 namespace {
@@ -28,7 +28,7 @@ struct CommandResult {
   std::string output;  // stdout and stderr
 };
 
-// The tiny sequence as a bag, and a --models folder the nodelets load quickly (test/ros/tiny_models.h).
+// The tiny sequence as a bag, and a --models folder the nodelets load quickly (test/support/tiny_models.h).
 class BenchCommand : public ::testing::Test {
  protected:
   void SetUp() override {

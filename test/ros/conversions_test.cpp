@@ -10,6 +10,8 @@
 #include <random>
 #include <stdexcept>
 
+#include "support/boxes.h"
+
 namespace ret3d {
 namespace {
 
@@ -45,34 +47,15 @@ void storeAs(double v, std::uint8_t* out, bool swap) {
 }
 
 void store(std::uint8_t datatype, double v, std::uint8_t* out, bool swap) {
-  switch (datatype) {
-    case PointField::INT8:
-      storeAs<std::int8_t>(v, out, swap);
-      break;
-    case PointField::UINT8:
-      storeAs<std::uint8_t>(v, out, swap);
-      break;
-    case PointField::INT16:
-      storeAs<std::int16_t>(v, out, swap);
-      break;
-    case PointField::UINT16:
-      storeAs<std::uint16_t>(v, out, swap);
-      break;
-    case PointField::INT32:
-      storeAs<std::int32_t>(v, out, swap);
-      break;
-    case PointField::UINT32:
-      storeAs<std::uint32_t>(v, out, swap);
-      break;
-    case PointField::FLOAT32:
-      storeAs<float>(v, out, swap);
-      break;
-    case PointField::FLOAT64:
-      storeAs<double>(v, out, swap);
-      break;
-    default:
-      FAIL() << "bad datatype";
-  }
+  using Store = void (*)(double, std::uint8_t*, bool);
+  static const std::map<std::uint8_t, Store> kStores = {
+      {PointField::INT8, storeAs<std::int8_t>},   {PointField::UINT8, storeAs<std::uint8_t>},
+      {PointField::INT16, storeAs<std::int16_t>}, {PointField::UINT16, storeAs<std::uint16_t>},
+      {PointField::INT32, storeAs<std::int32_t>}, {PointField::UINT32, storeAs<std::uint32_t>},
+      {PointField::FLOAT32, storeAs<float>},      {PointField::FLOAT64, storeAs<double>}};
+  const auto it = kStores.find(datatype);
+  ASSERT_NE(it, kStores.end()) << "bad datatype " << static_cast<int>(datatype);
+  it->second(v, out, swap);
 }
 
 // A PointCloud2 written byte by byte from per-point field values, independently of the code under test. Padding
@@ -535,14 +518,7 @@ TEST(ToPointCloud2, VelodyneDriverLayoutAndRoundTrip) {
 }
 
 Box makeBox(double yaw) {
-  Box b;
-  b.x = 12.5;
-  b.y = -3.25;
-  b.z = -0.8;
-  b.length = 4.2;
-  b.width = 1.8;
-  b.height = 1.55;
-  b.yaw = yaw;
+  Box b = test::makeBox(12.5, -3.25, -0.8, 4.2, 1.8, 1.55, yaw);
   b.vx = 3.5;
   b.vy = -0.5;
   b.score = 0.875f;
@@ -568,12 +544,7 @@ TEST(BoxMsg, RoundTripAcrossYawsIncludingPi) {
     EXPECT_NEAR(std::remainder(out.yaw - yaw, 2 * M_PI), 0.0, 1e-9) << yaw;
     EXPECT_GT(out.yaw, -M_PI);
     EXPECT_LE(out.yaw, M_PI);
-    EXPECT_DOUBLE_EQ(out.x, in.x);
-    EXPECT_DOUBLE_EQ(out.y, in.y);
-    EXPECT_DOUBLE_EQ(out.z, in.z);
-    EXPECT_DOUBLE_EQ(out.length, in.length);
-    EXPECT_DOUBLE_EQ(out.width, in.width);
-    EXPECT_DOUBLE_EQ(out.height, in.height);
+    test::expectSameCentreAndSize(out, in, 0.0);  // float64 fields both ways: exact
     EXPECT_DOUBLE_EQ(out.vx, in.vx);
     EXPECT_DOUBLE_EQ(out.vy, in.vy);
     EXPECT_EQ(out.score, in.score);

@@ -14,7 +14,7 @@
 #include "ret3d/sim/ray_caster.h"
 #include "ret3d/sim/scene.h"
 #include "ret3d/sim/simulator.h"
-#include "test_util.h"
+#include "support/test_util.h"
 
 namespace ret3d {
 namespace sim {

@@ -15,7 +15,7 @@
 #include "ret3d/io/kitti.h"
 #include "ret3d/sim/actors.h"
 #include "ret3d/sim/scene.h"
-#include "test_util.h"
+#include "support/test_util.h"
 
 namespace ret3d {
 namespace sim {

@@ -13,7 +13,7 @@
 #include "ret3d/io/detections.h"
 #include "ret3d/io/kitti.h"
 #include "ret3d/tracking/greedy_tracker.h"
-#include "test_util.h"
+#include "support/test_util.h"
 
 namespace ret3d {
 namespace {

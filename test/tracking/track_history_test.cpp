@@ -5,19 +5,13 @@
 #include <cmath>
 
 #include "ret3d/core/transform.h"
+#include "support/boxes.h"
 
 namespace ret3d {
 namespace {
 
 Box boxAt(double x, double y, double yaw = 0.0) {
-  Box b;
-  b.x = x;
-  b.y = y;
-  b.z = 1.0;
-  b.length = 4;
-  b.width = 2;
-  b.height = 1.5;
-  b.yaw = yaw;
+  Box b = test::makeBox(x, y, 1.0, 4, 2, 1.5, yaw);
   b.label = ObjectClass::Car;
   return b;
 }

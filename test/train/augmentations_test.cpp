@@ -11,7 +11,7 @@
 
 #include "ret3d/core/geometry.h"
 #include "ret3d/core/transform.h"
-#include "test_util.h"
+#include "support/test_util.h"
 
 namespace ret3d {
 namespace {

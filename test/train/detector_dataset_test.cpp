@@ -13,7 +13,8 @@
 #include "ret3d/detector/nn/heads.h"
 #include "ret3d/io/kitti.h"
 #include "ret3d/train/detector_dataset.h"
-#include "test_util.h"
+#include "support/error_message.h"
+#include "support/test_util.h"
 
 namespace ret3d {
 namespace {
@@ -125,12 +126,8 @@ TEST(DetectorDataset, ExplicitCoverOverridesTheDetection) {
 TEST(DetectorDataset, RejectsAFolderOfNeitherLayout) {
   test::TempDir dir;
   fs::create_directories(dir / "training/somethingelse");
-  try {
-    DetectorDataset data(dir.path(), ModelConfig());
-    FAIL() << "expected an error";
-  } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("neither a KITTI tracking layout"), std::string::npos) << e.what();
-  }
+  const std::string msg = test::errorMessage([&] { DetectorDataset data(dir.path(), ModelConfig()); });
+  EXPECT_NE(msg.find("neither a KITTI tracking layout"), std::string::npos) << msg;
 }
 
 nn::GroundTruth truthOf(const DetectorSample& s) {

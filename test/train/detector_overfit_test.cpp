@@ -15,7 +15,7 @@
 #include "ret3d/io/kitti.h"
 #include "ret3d/train/detector_dataset.h"
 #include "ret3d/train/detector_trainer.h"
-#include "test_util.h"
+#include "support/test_util.h"
 
 namespace ret3d {
 namespace {

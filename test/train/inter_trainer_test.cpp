@@ -4,7 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "ret3d/core/geometry.h"
-#include "test_util.h"
+#include "support/test_util.h"
 
 namespace ret3d {
 namespace train {

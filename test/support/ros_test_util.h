@@ -1,6 +1,7 @@
-// Shared by the pipeline rostests (test/nodes/*_test.cpp): a rosconsole appender that keeps every log line (to check
-// what a nodelet said), a wait helper, the in-process loading of the real nodelets, and PointCloud2 layouts a user may
-// have (Ouster, no intensity, uint8 intensity, big-endian) next to the velodyne one of toPointCloud2.
+// Shared by the pipeline rostests (test/rostest) and the command tests of test/ros: a rosconsole appender that keeps
+// every log line (to check what a nodelet said), a wait helper, the in-process loading of the real nodelets, and
+// PointCloud2 layouts a user may have (Ouster, no intensity, uint8 intensity, big-endian) next to the velodyne one of
+// toPointCloud2.
 #pragma once
 
 #include <fcntl.h>

@@ -1,10 +1,10 @@
-// rostest (test/replay.test, node `replay`): the bag-replay harness. The node writes a tiny sequence, converts it to a bag with the
-// project's converter, saves real (untrained) model files with the stages' own save functions, then runs the real
-// `roslaunch ret3d replay.launch bag:=... record:=...` (all five nodelets in one manager, rosbag play --clock with
-// use_sim_time, rosbag record) as a child process and checks the recorded bag: an /objects message for every input
-// cloud (drops at most 1 %), stamps and frame ids kept, the ground truth recorded beside it.
-// Accuracy (mAP, id stability against the ground truth) with the trained default models on a simulated drive:
-// test/nodes/replay_accuracy.cpp.
+// rostest (test/rostest/replay.test, node `replay`): the bag-replay harness. The node writes a tiny sequence, converts
+// it to a bag with the project's converter, saves real (untrained) model files with the stages' own save functions,
+// then runs the real `roslaunch ret3d replay.launch bag:=... record:=...` (all five nodelets in one manager, rosbag
+// play --clock with use_sim_time, rosbag record) as a child process and checks the recorded bag: an /objects message
+// for every input cloud (drops at most 1 %), stamps and frame ids kept, the ground truth recorded beside it. Accuracy
+// (mAP, id stability against the ground truth) with the trained default models on a simulated drive:
+// test/rostest/replay_accuracy.cpp.
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
@@ -13,16 +13,12 @@
 #include <set>
 #include <sstream>
 
-#include "nodes/pipeline_test_util.h"
-
-#include "ret3d/detector/detector.h"
-#include "ret3d/detector/nn/model.h"
-#include "ret3d/relation/inter_rm.h"
-#include "ret3d/relation/intra_rm.h"
 #include "ret3d/ros/bag_objects.h"
 #include "ret3d/ros/kitti_bag.h"
-#include "ros/tiny_sequence.h"
-#include "test_util.h"
+#include "support/ros_test_util.h"
+#include "support/test_util.h"
+#include "support/tiny_models.h"
+#include "support/tiny_sequence.h"
 
 namespace ret3d {
 namespace {
@@ -33,7 +29,7 @@ using test::readText;
 
 TEST(Replay, EveryCloudGivesObjectsInTheRecordedBag) {
   const char* package = std::getenv("RET3D_PACKAGE_DIR");
-  ASSERT_NE(package, nullptr) << "RET3D_PACKAGE_DIR not set (test/replay.test sets it)";
+  ASSERT_NE(package, nullptr) << "RET3D_PACKAGE_DIR not set (test/rostest/replay.test sets it)";
   test::TempDir tmp;
   test::TinySequence seq;
   seq.write(tmp.path(), "0000", kFrames, /*with_labels=*/true);
@@ -41,27 +37,7 @@ TEST(Replay, EveryCloudGivesObjectsInTheRecordedBag) {
   ASSERT_EQ(convertKittiToBag(tmp.path(), bag), static_cast<std::size_t>(kFrames));
 
   // Model files: the detector on a small grid (quick on 2 cores), the relation modules at small widths.
-  std::string config = readText(std::string(package) + "/config/detector/lwd3d_center.yaml");
-  for (const auto& [from, to] : std::vector<std::pair<std::string, std::string>>{{"x_min: -48.0", "x_min: -24.0"},
-                                                                                {"x_max: 48.0", "x_max: 24.0"},
-                                                                                {"y_min: -48.0", "y_min: -24.0"},
-                                                                                {"y_max: 48.0", "y_max: 24.0"},
-                                                                                {"resolution: 0.25", "resolution: 0.5"}}) {
-    const auto pos = config.find(from);
-    ASSERT_NE(pos, std::string::npos) << from;
-    config.replace(pos, from.size(), to);
-  }
-  std::ofstream(tmp / "detector.yaml") << config;
-  {
-    DetectorOptions options = loadDetectorOptions(tmp / "detector.yaml");
-    options.inference.threads = 1;
-    Detector(options).model().save(tmp / "detector.pt");
-  }
-  relation::IntraRM(relation::IntraRMArch{}, 1).save(tmp / "intra_rm.pt");
-  relation::InterRMArch inter;
-  inter.c_enc = 64;
-  inter.heads = 4;
-  relation::InterRM(inter, 1).save(tmp / "inter_rm.pt");
+  test::writeTinyModels(tmp.path(), package);
 
   const std::string out = tmp / "out.bag";
   const std::string log = tmp / "roslaunch.log";
@@ -97,9 +73,3 @@ TEST(Replay, EveryCloudGivesObjectsInTheRecordedBag) {
 
 }  // namespace
 }  // namespace ret3d
-
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "replay");
-  return RUN_ALL_TESTS();
-}

@@ -1,56 +1,25 @@
-// rostest (test/bag_play_test.test): a bag made by `ret3d convert` replays through a live ROS graph. The node writes a
-// tiny tracking sequence, converts it to a bag in a temporary folder, subscribes to /points, /ground_truth/objects
-// and tf, then runs the real `rosbag play` as a child process and checks that every cloud and every ground-truth
-// array arrives intact, and that tf places every cloud in odom at its stamp.
+// rostest (test/rostest/bag_play_test.test): a bag made by `ret3d convert` replays through a live ROS graph. The node
+// writes a tiny tracking sequence, converts it to a bag in a temporary folder, subscribes to /points,
+// /ground_truth/objects and tf, then runs the real `rosbag play` as a child process and checks that every cloud and
+// every ground-truth array arrives intact, and that tf places every cloud in odom at its stamp.
 #include <gtest/gtest.h>
 #include <ros/ros.h>
-#include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
+#include <unistd.h>
 
-#include <chrono>
 #include <mutex>
-#include <thread>
 
 #include "ret3d/ros/conversions.h"
 #include "ret3d/ros/kitti_bag.h"
-#include "ros/tiny_sequence.h"
-#include "test_util.h"
-
-extern char** environ;
+#include "support/ros_test_util.h"
+#include "support/test_util.h"
+#include "support/tiny_sequence.h"
 
 namespace ret3d {
 namespace {
 
 constexpr int kFrames = 5;
-
-// Runs `rosbag play` on the bag and waits for it to finish (it exits after the last message); stops it by its pid
-// after `timeout`. Returns its exit status, or -1 when it had to be stopped.
-int playBag(const std::string& bag, std::chrono::seconds timeout) {
-  // --wait-for-subscribers: nothing is published before this node is connected to every topic.
-  std::vector<std::string> args = {"rosbag", "play", "--quiet", "--wait-for-subscribers", bag};
-  std::vector<char*> argv;
-  for (auto& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  pid_t pid = 0;
-  const char* exe = access("/usr/bin/rosbag", X_OK) == 0 ? "/usr/bin/rosbag" : "rosbag";
-  if (posix_spawnp(&pid, exe, nullptr, nullptr, argv.data(), environ) != 0) return -2;
-  const auto deadline = std::chrono::steady_clock::now() + timeout;
-  int status = 0;
-  while (std::chrono::steady_clock::now() < deadline) {
-    if (waitpid(pid, &status, WNOHANG) == pid) return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-  kill(pid, SIGINT);
-  std::this_thread::sleep_for(std::chrono::seconds(2));
-  if (waitpid(pid, &status, WNOHANG) != pid) {
-    kill(pid, SIGKILL);
-    waitpid(pid, &status, 0);
-  }
-  return -1;
-}
 
 TEST(BagPlay, EveryCloudAndGroundTruthArrivesIntact) {
   test::TempDir tmp;
@@ -78,17 +47,18 @@ TEST(BagPlay, EveryCloudAndGroundTruthArrivesIntact) {
   ros::AsyncSpinner spinner(2);
   spinner.start();
 
-  ASSERT_EQ(playBag(bag, std::chrono::seconds(20)), 0) << "rosbag play failed or timed out";
+  // --wait-for-subscribers: nothing is published before this node is connected to every topic.
+  const std::string rosbag = access("/usr/bin/rosbag", X_OK) == 0 ? "/usr/bin/rosbag" : "rosbag";
+  const std::string log = tmp / "rosbag_play.log";
+  ASSERT_EQ(test::runLogged({rosbag, "play", "--quiet", "--wait-for-subscribers", bag}, log, 20.0), 0)
+      << "rosbag play failed or timed out\n"
+      << test::readText(log);
   // The last messages may still be in flight when rosbag exits.
-  for (int i = 0; i < 40; ++i) {
-    {
-      std::lock_guard<std::mutex> lock(mutex);
-      if (clouds.size() >= static_cast<std::size_t>(kFrames) && objects.size() >= static_cast<std::size_t>(kFrames)) {
-        break;
-      }
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
+  const auto all_arrived = [&] {
+    std::lock_guard<std::mutex> lock(mutex);
+    return clouds.size() >= static_cast<std::size_t>(kFrames) && objects.size() >= static_cast<std::size_t>(kFrames);
+  };
+  test::waitFor(all_arrived, 2.0);
   spinner.stop();
 
   std::lock_guard<std::mutex> lock(mutex);
@@ -137,9 +107,3 @@ TEST(BagPlay, EveryCloudAndGroundTruthArrivesIntact) {
 
 }  // namespace
 }  // namespace ret3d
-
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "bag_play_test");
-  return RUN_ALL_TESTS();
-}

@@ -1,17 +1,15 @@
-// rostest (test/replay_accuracy.test, node `replay_accuracy`): the bag-replay harness with the default trained models
-// (issue 8). It simulates a short urban drive with the real simulator (`ret3d sim ... --bag`, a seed never used for
-// training or selection), replays it through the real `roslaunch ret3d replay.launch` (all five nodelets in one
+// rostest (test/rostest/replay_accuracy.test, node `replay_accuracy`): the bag-replay harness with the default trained
+// models (issue 8). It simulates a short urban drive with the real simulator (`ret3d sim ... --bag`, a seed never used
+// for training or selection), replays it through the real `roslaunch ret3d replay.launch` (all five nodelets in one
 // manager, rosbag play --clock with use_sim_time, the launch's default models models/lwd3d/*.pt) and checks what was
-// recorded against the simulator's bag:
-// - an /objects message for every input cloud, drops at most 1 %; no output twice, none for a stamp never played;
-// - every output keeps its cloud's stamp and frame id;
-// - accuracy: `ret3d eval --gt SIM.bag --pred OUT.bag` (the command a user runs) gives a mean KITTI 3D AP R40
-//   moderate over Car, Pedestrian and Cyclist above kMinMeanAp;
-// - track ids: at least 90 % of the matched ground-truth track-frames carry their track's most frequent output id
-//   (eval::evaluateIdStability: Hungarian on centre distance, < 2 m, per class).
-// The figures are printed and recorded as test properties. test/replay.test checks the plumbing alone, quickly.
-// RET3D_REPLAY_DETECTOR_MODEL=FILE replays with another detector model (the launch's detector_model), e.g. to see
-// the accuracy check fail for an untrained one.
+// recorded against the simulator's bag: - an /objects message for every input cloud, drops at most 1 %; no output
+// twice, none for a stamp never played; - every output keeps its cloud's stamp and frame id; - accuracy: `ret3d eval
+// --gt SIM.bag --pred OUT.bag` (the command a user runs) gives a mean KITTI 3D AP R40 moderate over Car, Pedestrian and
+// Cyclist above kMinMeanAp; - track ids: at least 90 % of the matched ground-truth track-frames carry their track's
+// most frequent output id (eval::evaluateIdStability: Hungarian on centre distance, < 2 m, per class). The figures are
+// printed and recorded as test properties. test/rostest/replay.test checks the plumbing alone, quickly.
+// RET3D_REPLAY_DETECTOR_MODEL=FILE replays with another detector model (the launch's detector_model), e.g. to see the
+// accuracy check fail for an untrained one.
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <rosbag/bag.h>
@@ -28,11 +26,11 @@
 #include <map>
 #include <sstream>
 
-#include "nodes/pipeline_test_util.h"
+#include "support/ros_test_util.h"
 
 #include "ret3d/eval/id_stability.h"
 #include "ret3d/ros/bag_objects.h"
-#include "test_util.h"
+#include "support/test_util.h"
 
 namespace ret3d {
 namespace {
@@ -101,7 +99,7 @@ void report(const std::string& key, double value) {
 TEST(ReplayAccuracy, DefaultModelsOnASimulatedDrive) {
   const auto t0 = std::chrono::steady_clock::now();
   const char* package = std::getenv("RET3D_PACKAGE_DIR");
-  ASSERT_NE(package, nullptr) << "RET3D_PACKAGE_DIR not set (test/replay_accuracy.test sets it)";
+  ASSERT_NE(package, nullptr) << "RET3D_PACKAGE_DIR not set (test/rostest/replay_accuracy.test sets it)";
   test::TempDir tmp;
   const std::string cli = cliPath();
 
@@ -204,9 +202,3 @@ TEST(ReplayAccuracy, DefaultModelsOnASimulatedDrive) {
 
 }  // namespace
 }  // namespace ret3d
-
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "replay_accuracy");
-  return RUN_ALL_TESTS();
-}

@@ -1,6 +1,6 @@
-// rostest (test/rviz_check_test.test): rviz with rviz/ret3d.rviz under Xvfb shows the pipeline's markers in the class
-// colours of include/ret3d/ros/markers.h. The node runs the real MarkerNodelet (in-process nodelet::Loader), feeds it
-// a Car, a Pedestrian and a Cyclist beside a cloud with tf, starts Xvfb and rviz as child processes, takes a
+// rostest (test/rostest/rviz_check_test.test): rviz with rviz/ret3d.rviz under Xvfb shows the pipeline's markers in the
+// class colours of include/ret3d/ros/markers.h. The node runs the real MarkerNodelet (in-process nodelet::Loader),
+// feeds it a Car, a Pedestrian and a Cyclist beside a cloud with tf, starts Xvfb and rviz as child processes, takes a
 // screenshot with imagemagick's `import` and finds each class colour in it. With RET3D_SCREENSHOT set, the screenshot
 // is also copied there (docs/ret3d_rviz.png was made so).
 #include <gtest/gtest.h>
@@ -12,19 +12,19 @@
 #include <fstream>
 #include <thread>
 
-#include "nodes/pipeline_test_util.h"
 #include "ret3d/Object3DArray.h"
 #include "ret3d/ros/conversions.h"
 #include "ret3d/ros/markers.h"
-#include "ros/tiny_sequence.h"
-#include "test_util.h"
+#include "support/ros_test_util.h"
+#include "support/test_util.h"
+#include "support/tiny_sequence.h"
 
 namespace ret3d {
 namespace {
 
 TEST(RvizCheck, ClassColoursOnScreen) {
   const char* package = std::getenv("RET3D_PACKAGE_DIR");
-  ASSERT_NE(package, nullptr) << "RET3D_PACKAGE_DIR not set (test/rviz_check_test.test sets it)";
+  ASSERT_NE(package, nullptr) << "RET3D_PACKAGE_DIR not set (test/rostest/rviz_check_test.test sets it)";
   test::TempDir tmp;
   const std::string log = tmp / "children.log";
   const std::string display = ":" + std::to_string(90 + getpid() % 9);
@@ -117,10 +117,3 @@ TEST(RvizCheck, ClassColoursOnScreen) {
 
 }  // namespace
 }  // namespace ret3d
-
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "rviz_check_test");
-  ros::NodeHandle nh;
-  return RUN_ALL_TESTS();
-}

@@ -1,13 +1,13 @@
-// rostest (test/input_accounting_test.test): input accounting of the whole pipeline. The detector, IntraRM, tracker,
-// InterRM and marker nodelets run in one real nodelet manager (in-process nodelet::Loader) with real, untrained model
-// files (test/ros/tiny_models.h). Eight awkward inputs are played at about 10 Hz: an empty cloud, no intensity field,
-// uint8 intensity, NaN points, big-endian, an Ouster layout (organized, padded, extra fields), a million points and
-// stamps going backwards. From the nodelets' own /diagnostics alone it checks that every cloud is answered or dropped
-// under a named reason (frames in == frames out + the dropped.* counts, every stage), that each stage took in what
-// the stage before it put out (nothing lost silently between them), and that what was worked around is counted under
-// its kind (degraded.empty, degraded.over_point_limit, ...). A burst of clouds faster than the detector leaves no
-// queue: what it skips is counted as dropped.superseded and the newest cloud is always answered.
-// No timed assertion: every wait is for a condition, with generous timeouts.
+// rostest (test/rostest/input_accounting_test.test): input accounting of the whole pipeline. The detector, IntraRM,
+// tracker, InterRM and marker nodelets run in one real nodelet manager (in-process nodelet::Loader) with real,
+// untrained model files (test/support/tiny_models.h). Eight awkward inputs are played at about 10 Hz: an empty cloud,
+// no intensity field, uint8 intensity, NaN points, big-endian, an Ouster layout (organized, padded, extra fields), a
+// million points and stamps going backwards. From the nodelets' own /diagnostics alone it checks that every cloud is
+// answered or dropped under a named reason (frames in == frames out + the dropped.* counts, every stage), that each
+// stage took in what the stage before it put out (nothing lost silently between them), and that what was worked around
+// is counted under its kind (degraded.empty, degraded.over_point_limit, ...). A burst of clouds faster than the
+// detector leaves no queue: what it skips is counted as dropped.superseded and the newest cloud is always answered. No
+// timed assertion: every wait is for a condition, with generous timeouts.
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
@@ -22,12 +22,12 @@
 #include <string>
 #include <vector>
 
-#include "nodes/pipeline_test_util.h"
 #include "ret3d/DetectionArray.h"
 #include "ret3d/ros/conversions.h"
-#include "ros/tiny_models.h"
-#include "ros/tiny_sequence.h"
-#include "test_util.h"
+#include "support/ros_test_util.h"
+#include "support/test_util.h"
+#include "support/tiny_models.h"
+#include "support/tiny_sequence.h"
 
 namespace ret3d {
 namespace {
@@ -287,10 +287,3 @@ TEST_F(InputAccountingTest, ABurstFasterThanTheDetectorLeavesNoQueueAndWhatItSki
 
 }  // namespace
 }  // namespace ret3d
-
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "input_accounting_test");
-  ros::NodeHandle nh;
-  return RUN_ALL_TESTS();
-}

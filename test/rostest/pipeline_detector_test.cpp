@@ -1,4 +1,4 @@
-// rostest (test/pipeline_detector_test.test): the DetectorNodelet in a real nodelet manager (in-process
+// rostest (test/rostest/pipeline_detector_test.test): the DetectorNodelet in a real nodelet manager (in-process
 // nodelet::Loader) with a real model file (a freshly initialised LWD-3D network saved by the model's own save
 // function, on a small BEV grid so that the test is quick on 2 cores). It is fed clouds a user may have: the velodyne
 // layout with tf, an Ouster layout (organized, padded, float intensity in the thousands, uint32 time), no intensity,
@@ -18,41 +18,24 @@
 #include <mutex>
 #include <sstream>
 
-#include "nodes/pipeline_test_util.h"
 #include "ret3d/DetectionArray.h"
 #include "ret3d/core/transform.h"
 #include "ret3d/detector/detector.h"
 #include "ret3d/detector/nn/model.h"
 #include "ret3d/ros/conversions.h"
-#include "ros/tiny_sequence.h"
-#include "test_util.h"
+#include "support/ros_test_util.h"
+#include "support/test_util.h"
+#include "support/tiny_models.h"
+#include "support/tiny_sequence.h"
 
 namespace ret3d {
 namespace {
 
-// The default detector config with a 96 x 96 cell grid (48 m at 0.5 m): the same network, a quarter of the work.
-std::string smallConfig(const std::string& source_dir) {
-  std::ifstream in(source_dir + "/config/detector/lwd3d_center.yaml");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  std::string text = ss.str();
-  auto replace = [&](const std::string& from, const std::string& to) {
-    const auto pos = text.find(from);
-    if (pos != std::string::npos) text.replace(pos, from.size(), to);
-  };
-  replace("x_min: -48.0", "x_min: -24.0");
-  replace("x_max: 48.0", "x_max: 24.0");
-  replace("y_min: -48.0", "y_min: -24.0");
-  replace("y_max: 48.0", "y_max: 24.0");
-  replace("resolution: 0.25", "resolution: 0.5");
-  return text;
-}
-
 class DetectorNodeletTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    ASSERT_FALSE(source_dir_.empty()) << "RET3D_PACKAGE_DIR not set (test/pipeline_detector_test.test sets it)";
-    std::ofstream(tmp_ / "small.yaml") << smallConfig(source_dir_);
+    ASSERT_FALSE(source_dir_.empty()) << "RET3D_PACKAGE_DIR not set (test/rostest/pipeline_detector_test.test sets it)";
+    std::ofstream(tmp_ / "small.yaml") << test::smallDetectorConfig(source_dir_);
     DetectorOptions options = loadDetectorOptions(tmp_ / "small.yaml");
     options.inference.threads = 1;
     Detector fresh(options);  // empty model path: a freshly initialised network
@@ -302,7 +285,7 @@ TEST_F(DetectorNodeletTest, MissingModelIsRefused) {
 TEST_F(DetectorNodeletTest, WithoutConfigTheModelFilesOwnConfigIsUsed) {
   // A model saved with the config it was trained with runs without ~config (the launch file's default): an
   // anchor-head or a centre-head model alike, whichever the default model file holds.
-  const std::string small = smallConfig(source_dir_);
+  const std::string small = test::smallDetectorConfig(source_dir_);
   DetectorOptions options = detectorOptionsFromYaml(small);
   options.inference.threads = 1;
   Detector(options).model().save(tmp_ / "with_config.pt", small);
@@ -338,10 +321,3 @@ TEST_F(DetectorNodeletTest, WithoutConfigAModelThatStoresNoneOrACorruptOneIsRefu
 
 }  // namespace
 }  // namespace ret3d
-
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "pipeline_detector_test");
-  ros::NodeHandle nh;
-  return RUN_ALL_TESTS();
-}

@@ -1,6 +1,6 @@
-// rostest (test/pipeline_chain_test.test): the IntraRM -> tracker -> InterRM -> marker nodelets, loaded in one real
-// nodelet manager (in-process nodelet::Loader), fed the ground truth of a bag made by the project's converter from a
-// tiny generated sequence (its /tf, /tf_static and /ground_truth/objects, the latter published as detections).
+// rostest (test/rostest/pipeline_chain_test.test): the IntraRM -> tracker -> InterRM -> marker nodelets, loaded in one
+// real nodelet manager (in-process nodelet::Loader), fed the ground truth of a bag made by the project's converter from
+// a tiny generated sequence (its /tf, /tf_static and /ground_truth/objects, the latter published as detections).
 // Checks: an output on every topic for every input frame, stamps and frame ids kept, track ids stable, markers as
 // documented (DELETEALL first, class colours, labels, arrows, trails); the pipeline keeps going and says so when the
 // transform is missing or stamps go backwards; a nodelet with an invalid parameter or a missing/corrupt model file
@@ -16,15 +16,15 @@
 #include <map>
 #include <mutex>
 
-#include "nodes/pipeline_test_util.h"
 #include "ret3d/DetectionArray.h"
 #include "ret3d/Object3DArray.h"
 #include "ret3d/relation/inter_rm.h"
 #include "ret3d/relation/intra_rm.h"
 #include "ret3d/ros/conversions.h"
 #include "ret3d/ros/kitti_bag.h"
-#include "ros/tiny_sequence.h"
-#include "test_util.h"
+#include "support/ros_test_util.h"
+#include "support/test_util.h"
+#include "support/tiny_sequence.h"
 
 namespace ret3d {
 namespace {
@@ -333,10 +333,3 @@ TEST_F(PipelineStart, WrongParameterTypeIsNamed) {
 
 }  // namespace
 }  // namespace ret3d
-
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "pipeline_chain_test");
-  ros::NodeHandle nh;  // keeps the node up between the tests
-  return RUN_ALL_TESTS();
-}
