@@ -10,33 +10,22 @@
 #include <strings.h>
 
 #include "ret3d/core/geometry.h"
+#include "ret3d/core/enum_names.h"
 #include "parallel.h"
 
 namespace ret3d {
 namespace eval {
 
 const char* metricKey(KittiMetric m) {
-  switch (m) {
-    case KittiMetric::Box2D:
-      return "2d";
-    case KittiMetric::Bev:
-      return "bev";
-    case KittiMetric::Box3D:
-      return "3d";
-  }
-  return "?";
+  static constexpr std::array<const char*, kKittiNumMetrics> kNames = {"2d", "bev", "3d"};
+  static_assert(static_cast<int>(KittiMetric::Box3D) + 1 == kKittiNumMetrics);
+  return enumName(m, kNames);
 }
 
 const char* difficultyKey(KittiDifficulty d) {
-  switch (d) {
-    case KittiDifficulty::Easy:
-      return "easy";
-    case KittiDifficulty::Moderate:
-      return "moderate";
-    case KittiDifficulty::Hard:
-      return "hard";
-  }
-  return "?";
+  static constexpr std::array<const char*, kKittiNumDifficulties> kNames = {"easy", "moderate", "hard"};
+  static_assert(static_cast<int>(KittiDifficulty::Hard) + 1 == kKittiNumDifficulties);
+  return enumName(d, kNames);
 }
 
 double kittiAp11(const std::vector<double>& precision) {

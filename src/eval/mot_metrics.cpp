@@ -8,6 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "ret3d/core/enum_names.h"
 #include "ret3d/core/geometry.h"
 #include "assignment.h"
 #include "mot_sequence.h"
@@ -17,15 +18,9 @@ namespace ret3d {
 namespace eval {
 
 const char* similarityName(MotSimilarity s) {
-  switch (s) {
-    case MotSimilarity::Iou3d:
-      return "iou3d";
-    case MotSimilarity::IouBev:
-      return "bev";
-    case MotSimilarity::CenterDistance:
-      return "center";
-  }
-  return "?";
+  static constexpr std::array<const char*, 3> kNames = {"iou3d", "bev", "center"};
+  static_assert(static_cast<std::size_t>(MotSimilarity::CenterDistance) + 1 == kNames.size());
+  return enumName(s, kNames);
 }
 
 double motSimilarity(const Box& gt, const Box& pred, const MotOptions& options) {

@@ -8,6 +8,8 @@
 #include <limits>
 #include <sstream>
 
+#include "ret3d/core/enum_names.h"
+
 namespace ret3d {
 namespace io {
 
@@ -61,15 +63,11 @@ int countNumbered(const fs::path& dir, std::size_t digits) {
 }  // namespace
 
 const char* layoutName(DetectionLayout layout) {
-  switch (layout) {
-    case DetectionLayout::KittiObject:
-      return "KITTI object result files (FFFFFF.txt)";
-    case DetectionLayout::KittiTracking:
-      return "KITTI tracking result files (SSSS.txt)";
-    case DetectionLayout::PerClassCsv:
-      return "per-class comma-separated files (<Class>/SSSS.txt)";
-  }
-  return "?";
+  static constexpr std::array<const char*, 3> kNames = {"KITTI object result files (FFFFFF.txt)",
+                                                        "KITTI tracking result files (SSSS.txt)",
+                                                        "per-class comma-separated files (<Class>/SSSS.txt)"};
+  static_assert(static_cast<std::size_t>(DetectionLayout::PerClassCsv) + 1 == kNames.size());
+  return enumName(layout, kNames);
 }
 
 std::vector<kitti::Label> readPerClassCsvDetections(const std::string& path) {

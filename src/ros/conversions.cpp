@@ -3,6 +3,7 @@
 #include <sensor_msgs/PointField.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -20,69 +21,36 @@ using sensor_msgs::PointField;
 
 constexpr bool kHostIsBigEndian = __BYTE_ORDER__ == __ORDER_BIG_ENDIAN__;
 
-std::size_t datatypeSize(std::uint8_t datatype) {
-  switch (datatype) {
-    case PointField::INT8:
-    case PointField::UINT8:
-      return 1;
-    case PointField::INT16:
-    case PointField::UINT16:
-      return 2;
-    case PointField::INT32:
-    case PointField::UINT32:
-    case PointField::FLOAT32:
-      return 4;
-    case PointField::FLOAT64:
-      return 8;
-    default:
-      return 0;
-  }
+// PointField's datatypes 1 (INT8) to 8 (FLOAT64), in that order: name, bytes, largest positive value (the divisor
+// of IntensityScaling::DatatypeRange; 1 for the float types).
+struct DatatypeInfo {
+  const char* name;
+  std::size_t size;
+  double max;
+};
+template <typename T>
+constexpr double maxOf() {
+  return static_cast<double>(std::numeric_limits<T>::max());
 }
+constexpr std::array<DatatypeInfo, 8> kDatatypes = {{{"int8", 1, maxOf<std::int8_t>()},
+                                                     {"uint8", 1, maxOf<std::uint8_t>()},
+                                                     {"int16", 2, maxOf<std::int16_t>()},
+                                                     {"uint16", 2, maxOf<std::uint16_t>()},
+                                                     {"int32", 4, maxOf<std::int32_t>()},
+                                                     {"uint32", 4, maxOf<std::uint32_t>()},
+                                                     {"float32", 4, 1.0},
+                                                     {"float64", 8, 1.0}}};
+static_assert(PointField::INT8 == 1 && PointField::UINT32 == 6 && PointField::FLOAT64 == 8);
+constexpr DatatypeInfo kUnknownDatatype = {"unknown", 0, 1.0};
+
+const DatatypeInfo& datatypeInfo(std::uint8_t datatype) {
+  return datatype >= 1 && datatype <= kDatatypes.size() ? kDatatypes[datatype - 1] : kUnknownDatatype;
+}
+std::size_t datatypeSize(std::uint8_t datatype) { return datatypeInfo(datatype).size; }
+double datatypeMax(std::uint8_t datatype) { return datatypeInfo(datatype).max; }
+const char* datatypeName(std::uint8_t datatype) { return datatypeInfo(datatype).name; }
 
 bool isFloat(std::uint8_t datatype) { return datatype == PointField::FLOAT32 || datatype == PointField::FLOAT64; }
-
-// Largest positive value of an integer datatype (the divisor of IntensityScaling::DatatypeRange).
-double datatypeMax(std::uint8_t datatype) {
-  switch (datatype) {
-    case PointField::INT8:
-      return std::numeric_limits<std::int8_t>::max();
-    case PointField::UINT8:
-      return std::numeric_limits<std::uint8_t>::max();
-    case PointField::INT16:
-      return std::numeric_limits<std::int16_t>::max();
-    case PointField::UINT16:
-      return std::numeric_limits<std::uint16_t>::max();
-    case PointField::INT32:
-      return std::numeric_limits<std::int32_t>::max();
-    case PointField::UINT32:
-      return std::numeric_limits<std::uint32_t>::max();
-    default:
-      return 1.0;
-  }
-}
-
-const char* datatypeName(std::uint8_t datatype) {
-  switch (datatype) {
-    case PointField::INT8:
-      return "int8";
-    case PointField::UINT8:
-      return "uint8";
-    case PointField::INT16:
-      return "int16";
-    case PointField::UINT16:
-      return "uint16";
-    case PointField::INT32:
-      return "int32";
-    case PointField::UINT32:
-      return "uint32";
-    case PointField::FLOAT32:
-      return "float32";
-    case PointField::FLOAT64:
-      return "float64";
-    default:
-      return "unknown";
-  }
-}
 
 // double -> float; values beyond float's range become +-inf (a plain cast of those is undefined behaviour).
 float toFloat(double v) {

@@ -6,20 +6,15 @@
 #include <diagnostic_msgs/DiagnosticStatus.h>
 #include <ros/ros.h>
 
+#include "ret3d/core/enum_names.h"
 #include "ret3d/core/stats.h"
 
 namespace ret3d {
 
 const char* dropReasonName(DropReason reason) {
-  switch (reason) {
-    case DropReason::Superseded:
-      return "superseded";
-    case DropReason::TooOld:
-      return "too_old";
-    case DropReason::Error:
-      return "error";
-  }
-  return "unknown";
+  static constexpr std::array<const char*, kNumDropReasons> kNames = {"superseded", "too_old", "error"};
+  static_assert(static_cast<std::size_t>(DropReason::Error) + 1 == kNumDropReasons);
+  return enumName(reason, kNames, "unknown");
 }
 
 std::size_t StageMonitor::Snapshot::dropped() const {

@@ -6,7 +6,9 @@
 //   });
 #pragma once
 
+#include <array>
 #include <iostream>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -23,6 +25,23 @@ struct TrainRegistrar {
     trainRegistry().push_back({std::move(name), std::move(description), std::move(setup)});
   }
 };
+
+// `ret3d train <name>` of a relation module: Args (a RelationTrainArgs) gets the shared options with the help texts
+// of --data, --detections and --config, then the module's own (extra, optional); run gets it with the command line.
+template <class Args>
+TrainRegistrar relationTrainer(const std::string& name, const std::string& description,
+                               const std::array<std::string, 3>& help, int (*run)(const Args&),
+                               void (*extra)(CLI::App&, Args&) = nullptr) {
+  return TrainRegistrar(name, description, [=](CLI::App& app) -> CommandRun {
+    auto a = std::make_shared<Args>();
+    a->addOptions(app, help[0], help[1], help[2]);
+    if (extra) extra(app, *a);
+    return [a, &app, name, run]() {
+      a->command_line = commandLine("ret3d train " + name, app);
+      return run(*a);
+    };
+  });
+}
 
 // The relation modules' training input from this package's detector (--detector MODEL): its boxes and features on
 // the scans of a KITTI tracking folder, computed once and cached (train/detector_outputs.h).

@@ -61,19 +61,15 @@ int runTrainInter(const TrainInterArgs& a) {
   return 0;
 }
 
-TrainRegistrar reg("inter", "InterRM (Ret3D inter-frame relation module) on tracked detections",
-                   [](CLI::App& app) -> CommandRun {
-  auto a = std::make_shared<TrainInterArgs>();
-  a->addOptions(app, "KITTI tracking root with labels, calibration and poses (pose/ or oxts/)",
-                 "detector outputs: KITTI tracking result files or per-class CSV folders",
-                 "InterRM YAML config (default: built-in = config/relation/inter_rm.yaml)");
-  app.add_option("--intra-model", a->intra_model, "IntraRM model run on each frame before tracking (optional)");
-  app.add_option("--tracker-config", a->tracker_config, "tracker YAML (default: built-in = config/tracker.yaml)");
-  return [a, &app]() {
-    a->command_line = commandLine("ret3d train inter", app);
-    return runTrainInter(*a);
-  };
-});
+TrainRegistrar reg = relationTrainer<TrainInterArgs>(
+    "inter", "InterRM (Ret3D inter-frame relation module) on tracked detections",
+    {"KITTI tracking root with labels, calibration and poses (pose/ or oxts/)",
+     "detector outputs: KITTI tracking result files or per-class CSV folders",
+     "InterRM YAML config (default: built-in = config/relation/inter_rm.yaml)"},
+    runTrainInter, [](CLI::App& app, TrainInterArgs& a) {
+      app.add_option("--intra-model", a.intra_model, "IntraRM model run on each frame before tracking (optional)");
+      app.add_option("--tracker-config", a.tracker_config, "tracker YAML (default: built-in = config/tracker.yaml)");
+    });
 
 }  // namespace
 }  // namespace tools

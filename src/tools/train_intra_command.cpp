@@ -55,17 +55,12 @@ int runTrainIntra(const TrainIntraArgs& a) {
   return 0;
 }
 
-TrainRegistrar reg("intra", "IntraRM (Ret3D intra-frame relation module) on another detector's boxes",
-                   [](CLI::App& app) -> CommandRun {
-  auto a = std::make_shared<TrainIntraArgs>();
-  a->addOptions(app, "KITTI tracking (or object) root with labels and calibration",
-                 "detector outputs: KITTI object/tracking result files or per-class CSV folders",
-                 "IntraRM YAML config (default: built-in = config/relation/intra_rm.yaml)");
-  return [a, &app]() {
-    a->command_line = commandLine("ret3d train intra", app);
-    return runTrainIntra(*a);
-  };
-});
+TrainRegistrar reg = relationTrainer<TrainIntraArgs>(
+    "intra", "IntraRM (Ret3D intra-frame relation module) on another detector's boxes",
+    {"KITTI tracking (or object) root with labels and calibration",
+     "detector outputs: KITTI object/tracking result files or per-class CSV folders",
+     "IntraRM YAML config (default: built-in = config/relation/intra_rm.yaml)"},
+    runTrainIntra);
 
 }  // namespace
 }  // namespace tools
