@@ -23,8 +23,9 @@
 # have KITTI's proportions); a folder made by an older simulator is not reused.
 # Resumable: run it again after a stop and it continues from the last checkpoint (every 5 minutes); finished steps
 # are skipped. On the idle 2-core machine about 55 minutes for the two heads, 40 for the second stage and 20 for the
-# third (112 in all; on a host slowed by other load, up to twice that), then about 30 for steps 5-7. Work goes to
-# data/ and out/train_default/. The figures of a reproduction belong in models/lwd3d/MODEL_CARD.md.
+# third (112 in all; on a host slowed by other load, up to twice that), then about 30 for steps 5-7 (its first
+# end-to-end run, sessions 12-14 on a shared host: about 3.5 hours in all). Work goes to data/ and
+# out/train_default/. The figures of a reproduction belong in models/lwd3d/MODEL_CARD.md (the first run's are there).
 set -eo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$(pwd)
