@@ -8,12 +8,12 @@
 
 #include <gtest/gtest.h>
 
-#include "inter_rm_scenes.h"
-#include "relation/intra_rm_scenes.h"
 #include "ret3d/relation/inter_rm.h"
 #include "ret3d/relation/inter_rm_learner.h"
 #include "ret3d/relation/intra_rm.h"
-#include "test_util.h"
+#include "support/inter_rm_scenes.h"
+#include "support/intra_rm_scenes.h"
+#include "support/test_util.h"
 
 namespace ret3d {
 namespace relation {
