@@ -108,6 +108,43 @@ void InferenceOptions::validate() const {
   }
 }
 
+void SensorAugmentOptions::validate() const {
+  const OptionRange unit{0.0, 1.0};
+  for (const auto& [key, v] : {std::pair<const char*, double>{"ray_drop_min", ray_drop_min},
+                               {"ray_drop_max", ray_drop_max},
+                               {"ray_drop_far", ray_drop_far},
+                               {"beam_subsample_probability", beam_subsample_probability},
+                               {"intensity_jitter_probability", intensity_jitter_probability},
+                               {"intensity_zero_probability", intensity_zero_probability},
+                               {"intensity_zero_max", intensity_zero_max},
+                               {"intensity_constant_probability", intensity_constant_probability},
+                               {"intensity_constant_value", intensity_constant_value},
+                               {"previous_dropout_probability", previous_dropout_probability}})
+    checkOption(key, v, unit);
+  if (ray_drop_min > ray_drop_max) throw OptionError("ray_drop_min", "", "must not exceed ray_drop_max");
+  checkOption("min_box_points", min_box_points, {0.0});
+  checkOption("beam_subsample_keep_every", beam_subsample_keep_every, {2.0});
+  if (beam_subsample_probability > 0 && beam_sensor.empty())
+    throw OptionError("beam_sensor", "", "a sensor YAML is needed for beam_subsample_probability > 0");
+  checkOption("intensity_scale_min", intensity_scale_min, {0.0, 10.0});
+  checkOption("intensity_scale_max", intensity_scale_max, {intensity_scale_min, 10.0});
+  checkOption("intensity_gamma_min", intensity_gamma_min, {0.1, 10.0});
+  checkOption("intensity_gamma_max", intensity_gamma_max, {intensity_gamma_min, 10.0});
+  checkOption("intensity_noise_sigma", intensity_noise_sigma, {0.0, 0.5});
+  checkOption("pose_z_range", pose_z_range, {0.0, 1.0});
+  checkOption("pose_tilt_deg", pose_tilt_deg, {0.0, 10.0});
+  checkOption("gt_sample_margin", gt_sample_margin, {0.0, 5.0});
+  for (const auto& [c, n] : gt_sample_counts)
+    checkOption(std::string("gt_sample_counts.") + className(c), n, {0.0, 100.0});
+}
+
+void TrainOptions::validate() const {
+  checkOption("epochs", epochs, {1.0});
+  checkOption("batch_size", batch_size, {1.0});
+  checkOption("threads", threads, {0.0, 64.0});
+  sensor_augment.validate();
+}
+
 float InferenceOptions::candidateThreshold(ObjectClass c) const {
   for (const auto& [calibrated, weights] : point_refine.score_calibration)
     if (calibrated == c) return std::min(candidate_threshold, score_threshold);
@@ -272,31 +309,6 @@ void readSensorAugment(YamlReader& r, SensorAugmentOptions* a) {
   r.get("gt_database", &a->gt_database);
   readClassValues(r, "gt_sample_counts", &a->gt_sample_counts);
   r.get("gt_sample_margin", &a->gt_sample_margin);
-  for (const auto& [key, v] : {std::pair<const char*, double>{"ray_drop_min", a->ray_drop_min},
-                               {"ray_drop_max", a->ray_drop_max},
-                               {"ray_drop_far", a->ray_drop_far},
-                               {"beam_subsample_probability", a->beam_subsample_probability},
-                               {"intensity_jitter_probability", a->intensity_jitter_probability},
-                               {"intensity_zero_probability", a->intensity_zero_probability},
-                               {"intensity_zero_max", a->intensity_zero_max},
-                               {"intensity_constant_probability", a->intensity_constant_probability},
-                               {"intensity_constant_value", a->intensity_constant_value},
-                               {"previous_dropout_probability", a->previous_dropout_probability}})
-    r.within(key, v, 0.0, 1.0);
-  if (a->ray_drop_min > a->ray_drop_max) r.fail("ray_drop_min", "must not exceed ray_drop_max");
-  r.within("min_box_points", a->min_box_points, 0, YamlReader::kNoLimit);
-  r.within("beam_subsample_keep_every", a->beam_subsample_keep_every, 2, YamlReader::kNoLimit);
-  if (a->beam_subsample_probability > 0 && a->beam_sensor.empty())
-    r.fail("beam_sensor", "a sensor YAML is needed for beam_subsample_probability > 0");
-  r.within("intensity_scale_min", a->intensity_scale_min, 0.0, 10.0);
-  r.within("intensity_scale_max", a->intensity_scale_max, a->intensity_scale_min, 10.0);
-  r.within("intensity_gamma_min", a->intensity_gamma_min, 0.1, 10.0);
-  r.within("intensity_gamma_max", a->intensity_gamma_max, a->intensity_gamma_min, 10.0);
-  r.within("intensity_noise_sigma", a->intensity_noise_sigma, 0.0, 0.5);
-  r.within("pose_z_range", a->pose_z_range, 0.0, 1.0);
-  r.within("pose_tilt_deg", a->pose_tilt_deg, 0.0, 10.0);
-  r.within("gt_sample_margin", a->gt_sample_margin, 0.0, 5.0);
-  for (const auto& [c, n] : a->gt_sample_counts) r.within(std::string("gt_sample_counts.") + className(c), n, 0, 100);
 }
 
 void readTrain(YamlReader r, TrainOptions* t) {
@@ -325,8 +337,11 @@ void readTrain(YamlReader r, TrainOptions* t) {
   r.get("loss_weight_iou", &t->loss_weight_iou);
   readSensorAugment(r, &t->sensor_augment);
   r.finish();
-  r.within("epochs", t->epochs, 1, YamlReader::kNoLimit);
-  r.within("batch_size", t->batch_size, 1, YamlReader::kNoLimit);
+  try {
+    t->validate();
+  } catch (const OptionError& e) {
+    r.fail(e.key(), e.value().empty() ? e.reason() : e.reason() + ", got " + e.value());
+  }
 }
 
 void flatten(const YAML::Node& n, const std::string& prefix, std::map<std::string, std::string>* out) {

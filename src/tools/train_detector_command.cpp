@@ -4,6 +4,8 @@
 #include <iostream>
 #include <sstream>
 
+#include "ret3d/core/option_range.h"
+#include "ret3d/core/yaml_reader.h"
 #include "ret3d/train/detector_trainer.h"
 #include "tools/train_command.h"
 
@@ -51,13 +53,15 @@ CommandRun setup(CLI::App& app) {
       ->check(CLI::PositiveNumber);
   return [job, config, threads, covers, gt_database]() -> int {
     for (const std::string& c : *covers) job->label_cover.push_back(labelCoverFromName(c));
-    std::ifstream in(*config);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    job->config_text = ss.str();
+    job->config_text = readConfigText(*config, *config);  // a `base:` chain resolved, as stored in the model
     job->options = detectorOptionsFromYaml(job->config_text, *config);
     if (*threads > 0) job->options.train.threads = *threads;
     if (!gt_database->empty()) job->options.train.sensor_augment.gt_database = *gt_database;
+    try {
+      job->options.train.validate();
+    } catch (const OptionError& e) {
+      throw std::runtime_error("train detector: " + std::string(e.what()) + " (with the command line's overrides)");
+    }
     const DetectorTrainResult r = trainDetector(*job);
     std::cout << "trained " << r.steps << " steps in " << r.seconds << " s, last epoch loss " << r.last_loss
               << ", model " << job->out_model << std::endl;

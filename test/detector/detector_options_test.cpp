@@ -1,6 +1,7 @@
 #include "ret3d/detector/detector_options.h"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 
@@ -24,7 +25,20 @@ OptionError optionErrorOf(F f) {
   return OptionError("", "", "");
 }
 
+// The error reading a detector YAML text gives ("" when it is accepted).
+std::string yamlError(const std::string& yaml) {
+  return test::errorOrNothing([&] { detectorOptionsFromYaml(yaml); });
+}
+
 TEST(DetectorOptions, ShippedConfigsLoadAndValidate) {
+  // Every detector YAML of the repository (training stages, the long-range candidate) loads and validates.
+  int n = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(std::string(RET3D_SOURCE_DIR) + "/config/detector")) {
+    if (entry.path().extension() != ".yaml") continue;
+    EXPECT_NO_THROW(loadDetectorOptions(entry.path().string())) << entry.path();
+    ++n;
+  }
+  EXPECT_GE(n, 8);
   for (const char* name : {"lwd3d_center.yaml", "lwd3d_anchor.yaml"}) {
     const auto o = loadDetectorOptions(std::string(RET3D_SOURCE_DIR) + "/config/detector/" + name);
     EXPECT_EQ(o.model.classes.size(), 3u);
@@ -109,21 +123,13 @@ TEST(DetectorOptions, ModelConfigRoundTripsAndDiffsReadably) {
 // One range per value: the YAML reader, the nodelet's parameters, dynamic_reconfigure and the command line all refuse
 // through InferenceOptions::validate(), naming the key, the value and the range.
 TEST(DetectorOptions, EveryInferenceValueHasOneRangeAndARefusalNamesKeyValueAndRange) {
-  auto message = [](const std::string& yaml) -> std::string {
-    try {
-      detectorOptionsFromYaml(yaml);
-    } catch (const std::runtime_error& e) {
-      return e.what();
-    }
-    return "";
-  };
   // nms_iou had no check in YAML (and [0.01, 1] as a ROS parameter): now [0, 1] everywhere.
-  EXPECT_EQ(message("inference: {nms_iou: 1.5}"), "<string>: key 'inference.nms_iou': must lie in [0, 1], got 1.5");
-  EXPECT_EQ(message("inference: {nms_iou: 0}"), "");
-  EXPECT_EQ(message("inference: {max_detections: 0}"),
+  EXPECT_EQ(yamlError("inference: {nms_iou: 1.5}"), "<string>: key 'inference.nms_iou': must lie in [0, 1], got 1.5");
+  EXPECT_EQ(yamlError("inference: {nms_iou: 0}"), "");
+  EXPECT_EQ(yamlError("inference: {max_detections: 0}"),
             "<string>: key 'inference.max_detections': must lie in [1, 100000], got 0");
-  EXPECT_EQ(message("inference: {threads: 65}"), "<string>: key 'inference.threads': must lie in [1, 64], got 65");
-  EXPECT_EQ(message("inference: {heading_from_velocity: {Car: -1}}"),
+  EXPECT_EQ(yamlError("inference: {threads: 65}"), "<string>: key 'inference.threads': must lie in [1, 64], got 65");
+  EXPECT_EQ(yamlError("inference: {heading_from_velocity: {Car: -1}}"),
             "<string>: key 'inference.heading_from_velocity.Car': must be >= 0, got -1");
 
   InferenceOptions o;
@@ -136,6 +142,26 @@ TEST(DetectorOptions, EveryInferenceValueHasOneRangeAndARefusalNamesKeyValueAndR
   DetectorOptions d;
   d.inference.score_threshold = -0.5f;
   EXPECT_EQ(optionErrorOf([&] { d.validate(); }).key(), "inference.score_threshold");
+}
+
+// The training options have one validate() too, which the YAML reader and `ret3d train detector` (after its
+// --threads override) call: the same refusal either way.
+TEST(DetectorOptions, TrainingValuesHaveOneRangeInYamlAndInValidate) {
+  EXPECT_EQ(yamlError("train: {ray_drop_max: 1.5}"), "<string>: key 'train.ray_drop_max': must lie in [0, 1], got 1.5");
+  EXPECT_EQ(yamlError("train: {epochs: 0}"), "<string>: key 'train.epochs': must be >= 1, got 0");
+  EXPECT_EQ(yamlError("train: {ray_drop_min: 0.2, ray_drop_max: 0.1}"),
+            "<string>: key 'train.ray_drop_min': must not exceed ray_drop_max");
+  EXPECT_EQ(yamlError("train: {intensity_scale_min: 0.9, intensity_scale_max: 0.8}"),
+            "<string>: key 'train.intensity_scale_max': must lie in [0.9, 10], got 0.8");
+  EXPECT_EQ(yamlError("train: {epochs: 3, ray_drop_max: 0.3}"), "");
+
+  TrainOptions t;
+  EXPECT_NO_THROW(t.validate());
+  t.threads = 65;
+  EXPECT_EQ(std::string(optionErrorOf([&] { t.validate(); }).what()), "threads = 65: must lie in [0, 64]");
+  t.threads = 2;
+  t.sensor_augment.gt_sample_counts.emplace_back(ObjectClass::Pedestrian, 101);
+  EXPECT_EQ(optionErrorOf([&] { t.validate(); }).key(), "gt_sample_counts.Pedestrian");
 }
 
 TEST(DetectorOptions, AGridExtentIsFourFiniteOrderedNumbersAndFitsTheModel) {

@@ -5,17 +5,14 @@
 #include <stdexcept>
 #include <string>
 
+#include "support/error_message.h"
+
 namespace ret3d {
 namespace {
 
 // The message of the std::invalid_argument thrown by parsing `yaml`, or "" if none is thrown.
 std::string errorOf(const std::string& yaml) {
-  try {
-    parseTrackerOptions(yaml);
-  } catch (const std::invalid_argument& e) {
-    return e.what();
-  }
-  return "";
+  return test::errorOrNothing<std::invalid_argument>([&] { parseTrackerOptions(yaml); });
 }
 
 void expectSame(const TrackerOptions& a, const TrackerOptions& b) {

@@ -174,6 +174,8 @@ struct SensorAugmentOptions {
   double gt_sample_margin = 0.3;
 
   bool gtSamplingOn() const;
+  // Throws OptionError naming the key (as under `train:`) when a value is out of its range.
+  void validate() const;
 };
 
 struct TrainOptions {
@@ -207,6 +209,10 @@ struct TrainOptions {
   double loss_weight_velocity = 0.5;
   double loss_weight_iou = 1.0;   // the IoU-quality channels (anchor.iou_quality)
   SensorAugmentOptions sensor_augment;  // its keys sit directly under `train:`
+
+  // Throws OptionError naming the key below `train:` when a value is out of its range (sensor_augment's included):
+  // the one check of the YAML reader and of `ret3d train detector`'s overrides.
+  void validate() const;
 };
 
 struct DetectorOptions {
