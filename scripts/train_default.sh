@@ -177,20 +177,7 @@ calibrate() {
   local nocal=$OUT/selftrain_nocal.yaml cal=$OUT/selftrain_calibrated.yaml pred=$OUT/calib_pred
   local rel=data/sim4_relation_urban
   [ -f "$OUT/calibrated_sim4.done" ] && return
-  python3 - config/detector/lwd3d_anchor_selftrain.yaml "$nocal" <<'PY'
-import sys
-lines = open(sys.argv[1]).read().split("\n")
-out, skip = [], False
-for l in lines:
-    if l.strip().startswith("score_calibration:"):
-        skip = True
-        continue
-    if skip and l.startswith("      "):
-        continue
-    skip = False
-    out.append(l)
-open(sys.argv[2], "w").write("\n".join(out))
-PY
+  python3 scripts/calibration_config.py strip config/detector/lwd3d_anchor_selftrain.yaml "$nocal"
   # Fitted on the boxes the network scores >= 0.3 (uncalibrated, the candidates are the published boxes).
   ret3d detect --data $rel --detector-model "$model" --detector-config "$nocal" --stages base \
     --score-threshold 0.3 --out "$pred" >"$OUT/calib_detect.log" 2>&1
@@ -199,20 +186,8 @@ PY
     --no-shape >"$OUT/calib_ped.log"
   python3 scripts/fit_score_calibration.py --gt $rel --pred "$pred" --class Cyclist --iou 0.5 \
     --no-shape >"$OUT/calib_cyc.log"
-  python3 - "$nocal" "$cal" "$OUT/calib_car.log" "$OUT/calib_ped.log" "$OUT/calib_cyc.log" <<'PY'
-import re, sys
-weights = {}
-for log in sys.argv[3:]:
-    m = re.search(r"score_calibration: \{(\w+): (\[[^]]*\])\}", open(log).read())
-    weights[m.group(1)] = m.group(2)
-out = []
-for l in open(sys.argv[1]).read().split("\n"):
-    out.append(l)
-    if l.strip().startswith("centroid:"):
-        out.append("    score_calibration:   # refitted by scripts/train_default.sh")
-        out += ["      %s: %s" % (c, w) for c, w in sorted(weights.items())]
-open(sys.argv[2], "w").write("\n".join(out))
-PY
+  python3 scripts/calibration_config.py insert "$nocal" "$cal" "$OUT/calib_car.log" "$OUT/calib_ped.log" \
+    "$OUT/calib_cyc.log"
   ret3d train detector "${SIM4_TRAIN[@]}" --config "$cal" --init "$OUT/selftrain_2.pt" --out "$OUT/sim4.pt" \
     --threads 1 --resume >"$OUT/calib_save.log" 2>&1
   touch "$OUT/calibrated_sim4.done"
