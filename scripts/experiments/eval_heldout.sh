@@ -18,10 +18,15 @@ set -u
 source scripts/simulate_once.sh
 # HELDOUT_SEED picks another held-out set (data/sim_test_urban_<seed>): the seed fixes a scene's layout and traffic,
 # so a set whose seeds were looked at many times stays familiar even after the simulator changes (session 10: 9100).
+# EVAL_DATA evaluates an existing dataset instead (e.g. the validation set data/sim4_val_urban), the same way.
 HELDOUT_SEED=${HELDOUT_SEED:-9000}
 DATA=data/sim_test_urban
 [ "$HELDOUT_SEED" = 9000 ] || DATA=data/sim_test_urban_$HELDOUT_SEED
-simulate_once "$DATA" config/sim/urban_street.yaml 5 100 "$HELDOUT_SEED"
+if [ -n "${EVAL_DATA:-}" ]; then
+  DATA=$EVAL_DATA
+else
+  simulate_once "$DATA" config/sim/urban_street.yaml 5 100 "$HELDOUT_SEED"
+fi
 OUT=out/heldout/$NAME
 rm -rf "$OUT"
 mkdir -p "$OUT"

@@ -82,27 +82,24 @@ if [ ! -f "$OUT/${name}_cal.done" ]; then
   touch "$OUT/${name}_cal.done"
 fi
 
-# Validation (seeds 5000-5001), whole pipeline: the default, the default over the long grid, the candidate.
+# Validation (seeds 5000-5001), whole pipeline (scripts/experiments/eval_heldout.sh on the validation set, into
+# out/heldout/long_val_<name>): the default, the default over the long grid, the candidate.
 D=data/sim4_val_urban
 val() {  # name models [extra ret3d detect options]
-  local n=$1 m=$2 o=$OUT/val/$1
+  local n=$1 m=$2
   shift 2
-  rm -rf "$o"
-  mkdir -p "$o"
-  ret3d detect --data $D --models "$m" --stages base,intra,track,inter --out "$o/pred" "$@" >"$o/detect.log" 2>&1
-  ret3d eval --gt $D --pred "$o/pred" --out "$o/eval" --metric kitti,waymo,mot >"$o/eval.log" 2>&1
-  ret3d eval --gt $D --pred "$o/pred" --out "$o/eval_48m" --metric mot --mot-max-range 48 >"$o/eval48.log" 2>&1
-  python3 - "$o" "$n" <<'PY'
+  EVAL_DATA=$D scripts/experiments/eval_heldout.sh base,intra,track,inter "long_val_$n" --models "$m" "$@" \
+    >"$OUT/val_$n.log" 2>&1
+  python3 - "out/heldout/long_val_$n" "$n" <<'PY'
 import json, sys
 o, n = sys.argv[1:]
 m = json.load(open(o + "/eval/metrics.json"))
 m48 = json.load(open(o + "/eval_48m/metrics.json"))
-g = lambda k: m.get(k, float("nan"))
-l2 = sum(g("waymo.%s.L2.APH" % c) for c in ("Car", "Pedestrian", "Cyclist")) / 3
 print("| %s | %.2f / %.2f / %.2f | %.2f | %.2f / %.2f / %.2f | %.2f / %.2f / %.2f | %.2f |" % (
-    n, g("kitti.Car.3d.R40.moderate"), g("kitti.Pedestrian.3d.R40.moderate"), g("kitti.Cyclist.3d.R40.moderate"), l2,
-    g("waymo_range.Car.0-30.L2.AP"), g("waymo_range.Car.30-50.L2.AP"), g("waymo_range.Car.50+.L2.AP"),
-    g("mot.Car.MOTA"), g("mot.Pedestrian.MOTA"), g("mot.Cyclist.MOTA"), m48.get("mot.Car.MOTA", float("nan"))))
+    n, m["kitti.Car.3d.R40.moderate"], m["kitti.Pedestrian.3d.R40.moderate"], m["kitti.Cyclist.3d.R40.moderate"],
+    m["waymo.mean.L2.APH"], m["waymo_range.Car.0-30.L2.AP"], m["waymo_range.Car.30-50.L2.AP"],
+    m["waymo_range.Car.50+.L2.AP"], m["mot.Car.MOTA"], m["mot.Pedestrian.MOTA"], m["mot.Cyclist.MOTA"],
+    m48["mot.Car.MOTA"]))
 PY
 }
 echo "| | Car / Ped / Cyc 3D | L2 mAPH | Car L2 AP 0-30 / 30-50 / 50+ m | MOTA Car / Ped / Cyc | Car MOTA within 48 m |"
