@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "ret3d/Object3DArray.h"
+#include "ret3d/ros/bag_message.h"
 #include "ret3d/ros/conversions.h"
 
 namespace ret3d {
@@ -40,7 +41,12 @@ std::vector<StampedObjects> readBagObjects(const std::string& bag_path, const st
   std::vector<StampedObjects> out;
   rosbag::View view(bag, rosbag::TopicQuery(topic));
   for (const rosbag::MessageInstance& m : view) {
-    const auto msg = m.instantiate<ret3d::Object3DArray>();
+    boost::shared_ptr<ret3d::Object3DArray> msg;
+    try {
+      msg = readBagMessage<ret3d::Object3DArray>(m);
+    } catch (const std::runtime_error& e) {
+      throw std::runtime_error(bag_path + ": " + e.what());
+    }
     if (!msg) continue;
     StampedObjects s;
     s.stamp = msg->header.stamp.toSec();

@@ -23,6 +23,7 @@
 
 #include "ret3d/core/geometry.h"
 #include "ret3d/io/kitti.h"
+#include "ret3d/ros/bag_message.h"
 #include "ret3d/ros/conversions.h"
 
 namespace fs = std::filesystem;
@@ -399,6 +400,20 @@ std::string bagLayoutProblem(BagFile& file, std::uint64_t begin, std::uint64_t e
   return "";
 }
 
+// The `number`-th message of the bag (from 1) as an M; null, with the problem listed, when it is of another type or
+// its bytes do not hold an M. The reading goes on with the next message.
+template <class M>
+boost::shared_ptr<M> readListed(const rosbag::MessageInstance& m, std::size_t number, ProblemList& problems) {
+  try {
+    const auto msg = readBagMessage<M>(m);
+    if (!msg) problems.add(m.getTopic() + ": message cannot be read (md5sum mismatch)");
+    return msg;
+  } catch (const std::runtime_error& e) {
+    problems.add("message " + std::to_string(number) + " of the bag, " + e.what());
+    return nullptr;
+  }
+}
+
 struct CloudSeen {
   std::size_t index;
   ros::Time stamp;
@@ -448,8 +463,8 @@ CheckReport checkBag(const std::string& path, const std::string& fixed_frame) {
   std::size_t gt_count = 0, gt_without_cloud = 0, sized_clouds = 0;
   std::vector<double> gt_stamps;
 
-  // A damaged chunk or message (bad compression, a message shorter than its type) ends the reading with a problem
-  // rather than an exception: the report still lists what came before it.
+  // A damaged chunk (bad compression) ends the reading with a problem rather than an exception: the report still
+  // lists what came before it. A damaged message is listed, and the reading goes on (readListed).
   std::size_t messages_read = 0;
   try {
     for (const rosbag::MessageInstance& m : view) {
@@ -475,11 +490,8 @@ CheckReport checkBag(const std::string& path, const std::string& fixed_frame) {
 
       if (topic == kTfTopic || topic == kTfStaticTopic) {
         const bool is_static = topic == kTfStaticTopic;
-        const auto tf = m.instantiate<tf2_msgs::TFMessage>();
-        if (!tf) {
-          problems.add(topic + ": message cannot be read (md5sum mismatch)");
-          continue;
-        }
+        const auto tf = readListed<tf2_msgs::TFMessage>(m, messages_read, problems);
+        if (!tf) continue;
         for (const auto& t : tf->transforms) {
           if (!is_static) {
             auto& last = last_tf_stamp[t.child_frame_id];
@@ -495,11 +507,8 @@ CheckReport checkBag(const std::string& path, const std::string& fixed_frame) {
           }
         }
       } else if (topic == kPointsTopic) {
-        const auto msg = m.instantiate<sensor_msgs::PointCloud2>();
-        if (!msg) {
-          problems.add(topic + ": message cannot be read (md5sum mismatch)");
-          continue;
-        }
+        const auto msg = readListed<sensor_msgs::PointCloud2>(m, messages_read, problems);
+        if (!msg) continue;
         const std::size_t index = clouds.size();
         const std::string where = "cloud " + std::to_string(index) + " (stamp " + stampString(msg->header.stamp) + ")";
         if (index > 0 && msg->header.stamp <= last_cloud_stamp) {
@@ -526,11 +535,8 @@ CheckReport checkBag(const std::string& path, const std::string& fixed_frame) {
         clouds.push_back({index, msg->header.stamp, msg->header.frame_id});
         cloud_stamps.insert(msg->header.stamp.toSec());
       } else if (topic == kGroundTruthTopic) {
-        const auto msg = m.instantiate<ret3d::Object3DArray>();
-        if (!msg) {
-          problems.add(topic + ": message cannot be read (md5sum mismatch)");
-          continue;
-        }
+        const auto msg = readListed<ret3d::Object3DArray>(m, messages_read, problems);
+        if (!msg) continue;
         if (gt_count > 0 && msg->header.stamp <= last_gt_stamp) {
           problems.add(topic + " message " + std::to_string(gt_count) + " (stamp " + stampString(msg->header.stamp) +
                        "): stamp not after the previous one's " + stampString(last_gt_stamp));

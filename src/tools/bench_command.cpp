@@ -33,6 +33,7 @@
 #include "ret3d/core/stats.h"
 #include "ret3d/io/kitti.h"
 #include "ret3d/io/sweeps.h"
+#include "ret3d/ros/bag_message.h"
 #include "ret3d/ros/conversions.h"
 #include "ret3d/ros/params.h"
 #include "tools/command.h"
@@ -136,7 +137,7 @@ std::vector<BenchFrame> framesFromBag(const BenchArgs& a) {
   rosbag::View view(bag, rosbag::TopicQuery(topic));
   for (const rosbag::MessageInstance& m : view) {
     if (static_cast<int>(out.size()) >= a.max_frames) break;
-    const auto msg = m.instantiate<sensor_msgs::PointCloud2>();
+    const auto msg = readBagMessage<sensor_msgs::PointCloud2>(m);
     if (!msg) continue;
     out.push_back({ret3d::toCloud(*msg), Eigen::Isometry3d::Identity(), !out.empty()});
   }

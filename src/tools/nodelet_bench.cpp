@@ -41,6 +41,7 @@
 #include "ret3d/Object3DArray.h"
 #include "ret3d/core/json_writer.h"
 #include "ret3d/core/stats.h"
+#include "ret3d/ros/bag_message.h"
 #include "ret3d/ros/diagnostics.h"
 #include "ret3d/ros/params.h"
 
@@ -86,7 +87,7 @@ BagPlan scanBag(const NodeletBenchOptions& o) {
     for (const rosbag::MessageInstance& m : clouds) {
       if (plan.clouds == 0) {
         first = m.getTime();
-        const auto msg = m.instantiate<sensor_msgs::PointCloud2>();
+        const auto msg = readBagMessage<sensor_msgs::PointCloud2>(m);
         if (!msg) throw std::runtime_error(plan.topic + ": the first message is no sensor_msgs/PointCloud2");
         const double skew = (msg->header.stamp - m.getTime()).toSec();
         // A driver's stamp is a little before its record time; seconds apart means another clock (e.g. a bag
@@ -264,7 +265,7 @@ int playBag(const NodeletBenchOptions& o, const BagPlan& plan, int go_fd) {
       if (!ros::ok()) break;
       if (m.getTopic() == plan.topic) {
         if (in_pass >= plan.clouds || clouds >= total) break;
-        const auto msg = m.instantiate<sensor_msgs::PointCloud2>();
+        const auto msg = readBagMessage<sensor_msgs::PointCloud2>(m);
         if (!msg) continue;
         msg->header.stamp = wall(msg->header.stamp - ros::Duration(plan.stamp_skew) + shift);
         waitUntil(wall(m.getTime() + shift));
@@ -272,8 +273,8 @@ int playBag(const NodeletBenchOptions& o, const BagPlan& plan, int go_fd) {
         ++clouds, ++in_pass;
       } else if (m.getTopic() == kTfStatic) {
         if (pass > 0) continue;  // latched: once is enough
-        if (const auto msg = m.instantiate<tf2_msgs::TFMessage>()) tf_static.publish(msg);
-      } else if (const auto msg = m.instantiate<tf2_msgs::TFMessage>()) {
+        if (const auto msg = readBagMessage<tf2_msgs::TFMessage>(m)) tf_static.publish(msg);
+      } else if (const auto msg = readBagMessage<tf2_msgs::TFMessage>(m)) {
         for (geometry_msgs::TransformStamped& t : msg->transforms)
           if (!t.header.stamp.isZero()) t.header.stamp = wall(t.header.stamp - ros::Duration(plan.stamp_skew) + shift);
         waitUntil(wall(m.getTime() + shift));

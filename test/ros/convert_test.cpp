@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -277,6 +278,53 @@ TEST(ConvertCommand, CheckRefusesABagWithADamagedLengthFieldNamingIt) {
   const std::string msg = test::errorMessage([&] { checkBag(bag_path); });
   EXPECT_NE(msg.find(bag_path), std::string::npos) << msg;
   EXPECT_NE(msg.find("damaged"), std::string::npos) << msg;
+}
+
+// Found by fuzzing (test/fuzz/regressions/bag_check/cloud_data_huge_length): inside an intact record, a message whose
+// own length field is damaged made ROS's deserializer ask for gigabytes. --check lists that message and reads on.
+TEST(ConvertCommand, CheckListsAMessageWithADamagedLengthAndReadsOn) {
+  test::TempDir tmp;
+  const std::string bag_path = tmp / "damaged_cloud.bag";
+  PointCloud cloud;
+  for (int k = 0; k < 4; ++k) cloud.points.push_back({1.0f + k, 2, 3, 0.5f});
+  std_msgs::Header h;
+  h.frame_id = "odom";
+  sensor_msgs::PointCloud2 first;
+  {
+    rosbag::Bag bag(bag_path, rosbag::bagmode::Write);
+    for (double stamp : {10.0, 10.1}) {
+      h.stamp.fromSec(stamp);
+      const auto msg = toPointCloud2(cloud, h);
+      if (stamp == 10.0) first = msg;
+      bag.write("/points", h.stamp, msg);
+    }
+  }
+  {
+    // The first cloud's data: its uint32 length, then its bytes; the length becomes 3.7 GB.
+    std::fstream f(bag_path, std::ios::binary | std::ios::in | std::ios::out);
+    const std::string bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    std::string pattern(4, '\0');
+    const auto len = static_cast<std::uint32_t>(first.data.size());
+    std::memcpy(pattern.data(), &len, 4);
+    pattern.append(first.data.begin(), first.data.end());
+    const auto at = bytes.find(pattern);
+    ASSERT_NE(at, std::string::npos);
+    f.seekp(static_cast<std::streamoff>(at));
+    const std::uint32_t huge = 0xDC000000u;
+    f.write(reinterpret_cast<const char*>(&huge), sizeof(huge));
+  }
+  const CheckReport report = checkBag(bag_path);
+  EXPECT_FALSE(report.ok());
+  EXPECT_EQ(report.clouds, 1u) << report.summary();  // the second cloud is still read
+  ASSERT_EQ(report.problems.size(), 1u) << report.summary();
+  EXPECT_NE(report.problems[0].find("message 1 of the bag, /points: damaged sensor_msgs/PointCloud2 message"),
+            std::string::npos)
+      << report.summary();
+  EXPECT_NE(report.problems[0].find("an array of 3690987520 uint8"), std::string::npos) << report.summary();
+
+  const CommandResult check = run(cli() + " convert --check " + bag_path);
+  EXPECT_EQ(check.exit_code, 1) << check.output;
+  EXPECT_NE(check.output.find("damaged sensor_msgs/PointCloud2"), std::string::npos) << check.output;
 }
 
 TEST(ConvertCommand, RealUnlabeledScans) {
