@@ -117,7 +117,9 @@ class Walker {
     return true;
   }
   bool skip(std::size_t n, const std::string& what) {
-    if (n > size_ - pos_) return overrun("a " + what + " at byte " + std::to_string(pos_) + " of " + std::to_string(size_));
+    if (n > size_ - pos_) {
+      return overrun("a " + what + " at byte " + std::to_string(pos_) + " of " + std::to_string(size_));
+    }
     pos_ += n;
     return true;
   }

@@ -34,7 +34,9 @@ boost::shared_ptr<M> readBagMessage(const rosbag::MessageInstance& m) {
   const std::string problem = serializedMessageProblem(ros::message_traits::DataType<M>::value(),
                                                        ros::message_traits::Definition<M>::value(), bytes.data(),
                                                        bytes.size());
-  if (!problem.empty()) throw std::runtime_error(m.getTopic() + ": damaged " + m.getDataType() + " message: " + problem);
+  if (!problem.empty()) {
+    throw std::runtime_error(m.getTopic() + ": damaged " + m.getDataType() + " message: " + problem);
+  }
   auto msg = boost::make_shared<M>();
   ros::serialization::IStream in(bytes.data(), static_cast<std::uint32_t>(bytes.size()));
   ros::serialization::deserialize(in, *msg);
