@@ -150,9 +150,10 @@ TriangleMesh pedestrianMesh(const PersonShape& person, double phase, double swin
   return mesh;
 }
 
-TriangleMesh cyclistMesh(double length, double stature, double crank, const ActorSurfaces& s) {
+TriangleMesh cyclistMesh(const RiderShape& rider, double crank, const ActorSurfaces& s) {
   const float m = static_cast<float>(kLabelMargin);
-  const float Lb = static_cast<float>(length) - 2 * m, H = static_cast<float>(stature);
+  const float Lb = static_cast<float>(rider.length) - 2 * m, H = static_cast<float>(rider.stature);
+  const float half_bar = 0.5f * static_cast<float>(rider.bar_width), lean = static_cast<float>(rider.lean);
   TriangleMesh mesh;
   // Bicycle: wheels (tyre rings of beams), frame tubes, handlebar, cranks.
   const float r = std::clamp(0.19f * Lb, 0.3f, 0.36f);
@@ -176,7 +177,7 @@ TriangleMesh cyclistMesh(double length, double stature, double crank, const Acto
   mesh.addBeam(seat + V3(0, 0, -0.05f), head, 0.04f, s.metal);
   mesh.addBeam(head, front, 0.04f, s.metal);
   const V3 bar = head + V3(0.02f, 0, 0.12f);
-  mesh.addBeam(bar + V3(0, -0.27f, 0), bar + V3(0, 0.27f, 0), 0.035f, s.metal);
+  mesh.addBeam(bar + V3(0, -half_bar, 0), bar + V3(0, half_bar, 0), 0.035f, s.metal);
   mesh.addBox(translation(seat.x(), 0, seat.z() + 0.03f), V3(0.25f, 0.12f, 0.05f), s.tire);
   // Rider: hips on the saddle, torso leaning to the bars, legs on the pedals (two-link inverse kinematics).
   const float thigh = 0.245f * H, shin = 0.25f * H, crank_r = 0.17f;
@@ -199,19 +200,19 @@ TriangleMesh cyclistMesh(double length, double stature, double crank, const Acto
     mesh.addBox(translation(foot.x() + 0.04f, foot.y(), foot.z()), V3(0.24f, 0.09f, 0.07f), s.tire);
   }
   const float torso_len = 0.30f * H;
-  const V3 shoulder = hip + torso_len * V3(std::sin(0.75f), 0, std::cos(0.75f));  // about 43 degrees forward lean
+  const V3 shoulder = hip + torso_len * V3(std::sin(lean), 0, std::cos(lean));
   Eigen::Isometry3f T = Eigen::Isometry3f::Identity();
   T.translation() = 0.5f * (hip + shoulder);
-  T.linear() = Eigen::AngleAxisf(0.75f, V3::UnitY()).toRotationMatrix();
-  mesh.addBox(T, V3(0.13f * H, 0.34f, torso_len + 0.06f), s.clothing);
+  T.linear() = Eigen::AngleAxisf(lean, V3::UnitY()).toRotationMatrix();
+  mesh.addBox(T, V3(0.13f * H, static_cast<float>(rider.breadth), torso_len + 0.06f), s.clothing);
   const V3 head_c = shoulder + V3(0.10f, 0, 0.16f);
   mesh.addEllipsoid(translation(head_c.x(), 0, head_c.z()), V3(0.11f, 0.09f, 0.12f), 8, 5, s.clothing);  // helmet
   for (int side = -1; side <= 1; side += 2) {
-    const V3 sh = shoulder + V3(0, side * 0.2f, -0.02f);
-    const V3 hand = bar + V3(0, side * 0.24f, 0);
-    const V3 elbow = 0.5f * (sh + hand) + V3(-0.03f, side * 0.04f, -0.06f);
-    mesh.addBeam(sh, elbow, 0.08f, s.clothing);
-    mesh.addBeam(elbow, hand, 0.07f, s.skin);
+    const V3 sh = shoulder + V3(0, side * (0.5f * static_cast<float>(rider.breadth) + 0.03f), -0.02f);
+    const V3 hand = bar + V3(0, side * (half_bar - 0.03f), 0);
+    const V3 elbow = 0.5f * (sh + hand) + V3(-0.03f, side * 0.03f, -0.06f);
+    mesh.addBeam(sh, elbow, 0.05f, s.clothing);
+    mesh.addBeam(elbow, hand, 0.045f, s.skin);
   }
   return mesh;
 }

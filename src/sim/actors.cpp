@@ -11,6 +11,7 @@ namespace sim {
 namespace {
 
 PersonShape personShape(const Actor& a) { return {a.stature, a.breadth, a.depth, a.backpack}; }
+RiderShape riderShape(const Actor& a) { return {a.length, a.stature, a.bar_width, a.breadth, a.lean}; }
 
 using V2 = Eigen::Vector2d;
 
@@ -48,7 +49,8 @@ ActorSurfaces drawSurfaces(const SimConfig& c, Rng& rng) {
 }
 
 // Box of a pedestrian or cyclist: the bounds of its mesh over a whole gait (or crank) cycle, plus the label margin,
-// so one size per track (as a labeller draws it) holds every frame's mesh. A pedestrian's box is then drawn as KITTI's
+// so one size per track (as a labeller draws it) holds every frame's mesh; a cyclist's width then as KITTI's labellers
+// draw it (below). A pedestrian's box is then drawn as KITTI's
 // labellers draw theirs: looser than the body, one size per track, from the sizes of KITTI tracking's 165 pedestrian
 // tracks (width 0.68 +- 0.15 m, length 0.82 +- 0.23 m), never tighter than the mesh. Without it the boxes hugged the
 // shoulders (median width 0.53 m against KITTI's 0.73 per box), and a detector taught on them drew real pedestrians'
@@ -58,7 +60,7 @@ void fitArticulatedBox(Actor& a, Rng& rng) {
   for (int k = 0; k < 16; ++k) {
     const double ph = 2 * M_PI * k / 16;
     TriangleMesh m = a.kind == ActorKind::Pedestrian ? pedestrianMesh(personShape(a), ph, a.swing_max, a.surfaces)
-                                                     : cyclistMesh(a.length, a.stature, ph, a.surfaces);
+                                                     : cyclistMesh(riderShape(a), ph, a.surfaces);
     b.extend(m.bounds());
     if (a.kind == ActorKind::Pedestrian) b.extend(pedestrianMesh(personShape(a), ph, 0.5 * a.swing_max, a.surfaces).bounds());
   }
@@ -71,6 +73,10 @@ void fitArticulatedBox(Actor& a, Rng& rng) {
   if (a.kind == ActorKind::Pedestrian) {
     a.length = std::max(a.length, std::clamp(rng.normal(0.82, 0.2), 0.45, 1.2));
     a.width = std::max(a.width, std::clamp(rng.normal(0.68, 0.15), 0.45, 1.0));
+  } else {
+    // KITTI's labellers draw a cyclist's width looser or tighter than its elbows and handlebars (p10 0.47 m, narrower
+    // than any rider's arms on the bars): drawn here as they draw it, half from the build, half from their spread.
+    a.width = std::clamp(0.5 * a.width + 0.5 * rng.normal(0.60, 0.28), 0.42, 0.95);
   }
 }
 
@@ -139,7 +145,7 @@ TriangleMesh actorMesh(const Actor& a) {
   switch (a.kind) {
     case ActorKind::Pedestrian:
       return pedestrianMesh(personShape(a), phase, var == kPhaseSteps ? 0.0 : a.swing_max, a.surfaces);
-    case ActorKind::Cyclist: return cyclistMesh(a.length, a.stature, phase, a.surfaces);
+    case ActorKind::Cyclist: return cyclistMesh(riderShape(a), phase, a.surfaces);
     default: return carMesh(a.body, a.length, a.width, a.height, a.surfaces);
   }
 }
@@ -593,7 +599,13 @@ void Traffic::spawnCyclists(const Lane& l, const Path& route, double view_range,
     a.kind = ActorKind::Cyclist;
     a.surfaces = drawSurfaces(config_, rng);
     a.stature = std::clamp(rng.normal(1.76, 0.07), 1.55, 1.95);
-    a.length = std::clamp(rng.normal(1.78, 0.06), 1.6, 1.95);
+    // Builds of bicycle and rider, so that the label boxes spread as KITTI tracking's 36 cyclist tracks do (length /
+    // width / height p10-p90 1.59-1.93 / 0.47-0.84 / 1.64-1.85 m): bikes of every size, road to city handlebars,
+    // riders from upright to crouched.
+    a.length = std::clamp(rng.normal(1.73, 0.13), 1.45, 2.05);
+    a.bar_width = std::clamp(rng.normal(0.52, 0.09), 0.38, 0.72);
+    a.breadth = std::clamp(rng.normal(0.36, 0.03), 0.30, 0.44) * a.stature / 1.76;
+    a.lean = std::clamp(rng.normal(0.6, 0.25), 0.2, 1.05);
     a.phase = rng.uniform(0, 2 * M_PI);
     fitArticulatedBox(a, rng);
     a.mesh = actorMesh(a);

@@ -55,6 +55,9 @@ ReplayData loadReplay(const std::string& root, const std::string& sequence, cons
         a.swing_max = 0.35;
       } else if (kind == ActorKind::Cyclist) {
         a.stature = std::max(1.2, l.h - 0.0);
+        // The handlebars span the label's width less the rider's hands and the margins.
+        a.bar_width = std::clamp(l.w - 0.19, 0.38, 0.72);
+        a.breadth = 0.34;
       }
       a.mesh = actorMesh(a);
       a.replay.assign(out.frames, std::nullopt);

@@ -69,10 +69,17 @@ TEST(ActorMeshes, PedestrianWalksAndCyclistPedals) {
   };
   EXPECT_NEAR(back({1.75, 0.45, 0.34}) - back({1.75, 0.45, 0.30}), 0.02, 0.003);
   EXPECT_NEAR(back({1.75, 0.45, 0.30, true}) - back({1.75, 0.45, 0.30}), 0.14, 0.01);
-  const Eigen::AlignedBox3f c = cyclistMesh(1.78, 1.76, 0.3, plain()).bounds();
+  const Eigen::AlignedBox3f c = cyclistMesh(RiderShape{}, 0.3, plain()).bounds();
   EXPECT_NEAR(c.sizes().x(), 1.78 - 2 * kLabelMargin, 0.08);
   EXPECT_NEAR(c.max().z(), 1.7, 0.12);
   EXPECT_NEAR(c.sizes().y(), 0.6, 0.12);
+  // The build shows: handlebars set the width, the lean the height.
+  RiderShape road, city;
+  road.bar_width = 0.40, road.lean = 0.95;
+  city.bar_width = 0.64, city.lean = 0.30;
+  const Eigen::AlignedBox3f r = cyclistMesh(road, 0.3, plain()).bounds(), u = cyclistMesh(city, 0.3, plain()).bounds();
+  EXPECT_NEAR(u.sizes().y() - r.sizes().y(), 0.17, 0.04);
+  EXPECT_GT(u.max().z() - r.max().z(), 0.08);
 }
 
 }  // namespace

@@ -35,9 +35,16 @@ struct PersonShape {
 // (radians, 0 = standing). Origin between the feet.
 TriangleMesh pedestrianMesh(const PersonShape& p, double phase, double swing, const ActorSurfaces& s);
 
-// A bicycle `length` long with a rider of `stature`, crank at angle `crank` (radians). Origin on the ground at the
-// middle of the wheelbase.
-TriangleMesh cyclistMesh(double length, double stature, double crank, const ActorSurfaces& s);
+// A cyclist's build: the bicycle `length` long (wheels included, plus the label margin at each end) with handlebars
+// `bar_width` across (road bikes about 0.40 m, city and mountain bikes 0.55-0.72), a rider of `stature` whose torso
+// is `breadth` across and leans `lean` radians forward of vertical (0.3 upright on a city bike, 0.9 on a road bike).
+struct RiderShape {
+  double length = 1.78, stature = 1.76, bar_width = 0.54, breadth = 0.34, lean = 0.75;
+};
+
+// A bicycle and rider of build `r`, crank at angle `crank` (radians). Origin on the ground at the middle of the
+// wheelbase.
+TriangleMesh cyclistMesh(const RiderShape& r, double crank, const ActorSurfaces& s);
 
 }  // namespace sim
 }  // namespace ret3d

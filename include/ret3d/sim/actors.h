@@ -32,8 +32,9 @@ struct Actor {
   // Label box size and where its centre sits in the actor frame (x forward; the mesh origin is on the ground).
   double length = 4, width = 1.7, height = 1.5;
   Eigen::Vector2d box_offset = Eigen::Vector2d::Zero();
-  double stature = 1.75, breadth = 0.45, swing_max = 0.4;  // pedestrians and riders
+  double stature = 1.75, breadth = 0.45, swing_max = 0.4;  // pedestrians and riders (a rider's breadth: the torso's)
   double depth = 0.27;          // pedestrians: chest to back, clothes included
+  double bar_width = 0.54, lean = 0.75;  // cyclists: handlebars across (m), torso forward of vertical (rad)
   bool backpack = false;        // pedestrians
   double phase = 0;             // gait or crank angle
   ActorSurfaces surfaces;
