@@ -17,7 +17,8 @@ PACKAGES=(
   libopenblas0-openmp
   # ROS 1 from Debian
   ros-core-dev libroscpp-dev libnodeletlib-dev libnodeletlib-tools pluginlib-dev libtf2-ros-dev libtf2-eigen-dev
-  libpcl-ros-dev libpcl-dev librosbag-dev librostest-dev python3-rostest python3-roslaunch python3-rosbag
+  libpcl-ros-dev libpcl-dev librosbag-dev libroslz4-dev libbz2-dev librostest-dev python3-rostest python3-roslaunch
+  python3-rosbag
   python3-rostopic python3-rosnode rosbash ros-message-generation ros-sensor-msgs ros-visualization-msgs
   python3-sensor-msgs python3-geometry-msgs python3-visualization-msgs python3-tf2-msgs
   libdiagnostic-updater-dev libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure

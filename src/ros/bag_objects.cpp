@@ -7,18 +7,14 @@
 #include <stdexcept>
 
 #include "ret3d/Object3DArray.h"
-#include "ret3d/ros/bag_message.h"
+#include "ret3d/ros/bag_reader.h"
 #include "ret3d/ros/conversions.h"
 
 namespace ret3d {
 
 std::vector<StampedObjects> readBagObjects(const std::string& bag_path, const std::string& topic) {
   rosbag::Bag bag;
-  try {
-    bag.open(bag_path, rosbag::bagmode::Read);
-  } catch (const rosbag::BagException& e) {
-    throw std::runtime_error(bag_path + ": cannot open bag: " + e.what());
-  }
+  openCheckedBag(bag, bag_path);
   const std::string wanted = ros::message_traits::DataType<ret3d::Object3DArray>::value();
   bool found = false;
   std::ostringstream topics;

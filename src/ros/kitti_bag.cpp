@@ -23,7 +23,7 @@
 
 #include "ret3d/core/geometry.h"
 #include "ret3d/io/kitti.h"
-#include "ret3d/ros/bag_message.h"
+#include "ret3d/ros/bag_reader.h"
 #include "ret3d/ros/conversions.h"
 
 namespace fs = std::filesystem;
@@ -310,96 +310,6 @@ std::string stampString(const ros::Time& t) {
   return oss.str();
 }
 
-// rosbag allocates whatever a record's length fields say before it reads the record, so a damaged bag of a few
-// kilobytes can make it ask for gigabytes. The layout is checked first with small reads: every record (header fields,
-// data, and the records inside uncompressed chunks) must fit in the file, a record header may not exceed
-// kMaxHeaderBytes and a chunk may not announce more than kMaxChunkBytes unpacked. Returns the first problem, empty
-// when the layout is sound. Bag format 2.0: "#ROSBAG V2.0\n", then records: uint32 header length, header fields
-// (uint32 length, name=value), uint32 data length, data.
-constexpr std::uint64_t kMaxHeaderBytes = 16ull << 20;
-constexpr std::uint64_t kMaxChunkBytes = 512ull << 20;
-
-class BagFile {
- public:
-  explicit BagFile(const std::string& path) : in_(path, std::ios::binary) {
-    if (in_) {
-      in_.seekg(0, std::ios::end);
-      size_ = static_cast<std::uint64_t>(in_.tellg());
-    }
-  }
-  bool ok() const { return static_cast<bool>(in_); }
-  std::uint64_t size() const { return size_; }
-  std::string read(std::uint64_t at, std::uint64_t n) {
-    std::string out(n, '\0');
-    in_.seekg(static_cast<std::streamoff>(at));
-    in_.read(out.data(), static_cast<std::streamsize>(n));
-    if (!in_) throw std::runtime_error("read failed at byte " + std::to_string(at));
-    return out;
-  }
-  std::uint64_t u32(std::uint64_t at) {
-    std::uint32_t v;
-    std::memcpy(&v, read(at, 4).data(), 4);
-    return v;
-  }
-
- private:
-  std::ifstream in_;
-  std::uint64_t size_ = 0;
-};
-
-std::string bagLayoutProblem(BagFile& file, std::uint64_t begin, std::uint64_t end, bool top_level) {
-  std::uint64_t pos = begin;
-  while (pos < end) {
-    const std::string where = "record at byte " + std::to_string(pos);
-    if (end - pos < 4) return where + ": truncated";
-    const std::uint64_t header_len = file.u32(pos);
-    if (header_len > end - pos - 4) return where + ": header of " + std::to_string(header_len) + " bytes past the end";
-    if (header_len > kMaxHeaderBytes) return where + ": header of " + std::to_string(header_len) + " bytes";
-    const std::uint64_t data_len_at = pos + 4 + header_len;
-    if (end - data_len_at < 4) return where + ": truncated";
-    const std::uint64_t data_len = file.u32(data_len_at), data_at = data_len_at + 4;
-    if (data_len > end - data_at) return where + ": data of " + std::to_string(data_len) + " bytes past the end";
-    const std::string header = file.read(pos + 4, header_len);
-    std::map<std::string, std::string> fields;
-    for (std::size_t f = 0; f < header.size();) {
-      if (header.size() - f < 4) return where + ": truncated header field";
-      std::uint32_t field_len;
-      std::memcpy(&field_len, header.data() + f, 4);
-      if (field_len > header.size() - f - 4) return where + ": header field past the header's end";
-      const std::string field = header.substr(f + 4, field_len);
-      const auto eq = field.find('=');
-      if (eq == std::string::npos) return where + ": header field without '='";
-      fields[field.substr(0, eq)] = field.substr(eq + 1);
-      f += 4 + field_len;
-    }
-    const auto op = fields.find("op");
-    if (op == fields.end() || op->second.size() != 1) return where + ": no op field";
-    if (top_level && op->second[0] == 0x03) {  // bag header: where the index starts
-      const auto index = fields.find("index_pos");
-      if (index == fields.end() || index->second.size() != 8) return where + ": bag header without index_pos";
-      std::uint64_t index_pos;
-      std::memcpy(&index_pos, index->second.data(), 8);
-      if (index_pos > file.size()) return where + ": index position past the end";
-    }
-    if (top_level && op->second[0] == 0x05) {  // chunk
-      const auto compression = fields.find("compression");
-      const auto size = fields.find("size");
-      if (compression == fields.end() || size == fields.end() || size->second.size() != 4)
-        return where + ": chunk without compression or size";
-      std::uint32_t unpacked;
-      std::memcpy(&unpacked, size->second.data(), 4);
-      if (unpacked > kMaxChunkBytes) return where + ": chunk of " + std::to_string(unpacked) + " bytes unpacked";
-      if (compression->second == "none") {
-        if (unpacked != data_len) return where + ": uncompressed chunk whose size differs from its data";
-        const std::string inner = bagLayoutProblem(file, data_at, data_at + data_len, false);
-        if (!inner.empty()) return "chunk at byte " + std::to_string(pos) + ": " + inner;
-      }
-    }
-    pos = data_at + data_len;
-  }
-  return "";
-}
-
 // The `number`-th message of the bag (from 1) as an M; null, with the problem listed, when it is of another type or
 // its bytes do not hold an M. The reading goes on with the next message.
 template <class M>
@@ -427,21 +337,8 @@ CheckReport checkBag(const std::string& path, const std::string& fixed_frame) {
   report.bag = path;
   ProblemList problems(report);
 
-  {
-    BagFile file(path);
-    if (!file.ok()) throw std::runtime_error("cannot open bag '" + path + "'");
-    const std::string magic = "#ROSBAG V2.0\n";
-    if (file.size() < magic.size() || file.read(0, magic.size()) != magic)
-      throw std::runtime_error("cannot open bag '" + path + "': not a rosbag 2.0 file");
-    const std::string problem = bagLayoutProblem(file, magic.size(), file.size(), true);
-    if (!problem.empty()) throw std::runtime_error("cannot open bag '" + path + "': damaged: " + problem);
-  }
   rosbag::Bag bag;
-  try {
-    bag.open(path, rosbag::bagmode::Read);
-  } catch (const rosbag::BagException& e) {
-    throw std::runtime_error("cannot open bag '" + path + "': " + e.what());
-  }
+  openCheckedBag(bag, path);
   rosbag::View view(bag);
   const ros::Time begin = view.size() > 0 ? view.getBeginTime() : ros::Time();
   const ros::Time end = view.size() > 0 ? view.getEndTime() : ros::Time();

@@ -33,7 +33,7 @@
 #include "ret3d/core/stats.h"
 #include "ret3d/io/kitti.h"
 #include "ret3d/io/sweeps.h"
-#include "ret3d/ros/bag_message.h"
+#include "ret3d/ros/bag_reader.h"
 #include "ret3d/ros/conversions.h"
 #include "ret3d/ros/params.h"
 #include "tools/command.h"
@@ -122,7 +122,8 @@ std::vector<BenchFrame> framesFromData(const BenchArgs& a) {
 }
 
 std::vector<BenchFrame> framesFromBag(const BenchArgs& a) {
-  rosbag::Bag bag(a.bag, rosbag::bagmode::Read);
+  rosbag::Bag bag;
+  openCheckedBag(bag, a.bag);
   std::string topic = a.topic;
   if (topic.empty()) {
     rosbag::View all(bag);

@@ -41,7 +41,7 @@
 #include "ret3d/Object3DArray.h"
 #include "ret3d/core/json_writer.h"
 #include "ret3d/core/stats.h"
-#include "ret3d/ros/bag_message.h"
+#include "ret3d/ros/bag_reader.h"
 #include "ret3d/ros/diagnostics.h"
 #include "ret3d/ros/params.h"
 
@@ -71,7 +71,8 @@ BagPlan scanBag(const NodeletBenchOptions& o) {
   if (!fs::is_regular_file(o.bag)) throw std::runtime_error(o.bag + ": no such file");
   BagPlan plan;
   try {
-    rosbag::Bag bag(o.bag, rosbag::bagmode::Read);
+    rosbag::Bag bag;
+    openCheckedBag(bag, o.bag);
     rosbag::View all(bag);
     for (const rosbag::ConnectionInfo* c : all.getConnections()) {
       if (c->datatype == "sensor_msgs/PointCloud2" && (o.topic.empty() ? plan.topic.empty() : c->topic == o.topic))
@@ -247,7 +248,8 @@ int playBag(const NodeletBenchOptions& o, const BagPlan& plan, int go_fd) {
     const ros::Duration d = t - ros::Time::now();
     if (d > ros::Duration(0)) d.sleep();
   };
-  rosbag::Bag bag(o.bag, rosbag::bagmode::Read);
+  rosbag::Bag bag;
+  openCheckedBag(bag, o.bag);  // checked again: the file may have changed since scanBag
   std::vector<std::string> topics = {plan.topic};
   if (plan.tf) topics.push_back(kTf);
   if (plan.tf_static) topics.push_back(kTfStatic);
