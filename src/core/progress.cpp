@@ -21,6 +21,11 @@ void ProgressBar::tick(std::size_t n, const std::string& info) {
   draw(done_ >= total_);
 }
 
+void ProgressBar::skip(std::size_t n) {
+  skipped_ += n;
+  tick(n);
+}
+
 void ProgressBar::setInfo(const std::string& info) {
   info_ = info;
   draw(false);
@@ -38,7 +43,7 @@ void ProgressBar::draw(bool force) {
   const auto now = std::chrono::steady_clock::now();
   const double elapsed = std::chrono::duration<double>(now - start_).count();
   const double frac = total_ > 0 ? std::min(1.0, static_cast<double>(done_) / static_cast<double>(total_)) : 1.0;
-  const double rate = elapsed > 0 ? done_ / elapsed : 0.0;
+  const double rate = elapsed > 0 ? (done_ - skipped_) / elapsed : 0.0;
   const double eta = rate > 0 && total_ > done_ ? (total_ - done_) / rate : 0.0;
   const int eta_s = static_cast<int>(eta + 0.5);
   if (tty_) {

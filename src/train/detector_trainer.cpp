@@ -148,7 +148,7 @@ DetectorTrainResult trainDetector(const DetectorTrainJob& job) {
     total_steps += epoch_batches_n[e];
   }
   ProgressBar bar("train detector", static_cast<std::size_t>(total_steps));
-  if (ck.step > 0) bar.tick(static_cast<std::size_t>(ck.step));
+  if (ck.step > 0) bar.skip(static_cast<std::size_t>(ck.step));
   auto last_ckpt = std::chrono::steady_clock::now();
   DetectorTrainResult result;
   BevEncoderOptions enc_opt = o.bevOptions();

@@ -14,6 +14,8 @@ class ProgressBar {
   ~ProgressBar();  // finishes the line
   // Advance by n; `info` is shown after the counts (e.g. the current losses).
   void tick(std::size_t n = 1, const std::string& info = "");
+  // Advance by n steps done before this bar started (a resumed job): counted, but not in the rate.
+  void skip(std::size_t n);
   void setInfo(const std::string& info);
   void finish();
 
@@ -22,6 +24,7 @@ class ProgressBar {
   std::string label_;
   std::size_t total_;
   std::size_t done_ = 0;
+  std::size_t skipped_ = 0;
   std::string info_;
   bool tty_;
   bool finished_ = false;
