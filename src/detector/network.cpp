@@ -7,7 +7,8 @@ namespace nn {
 
 namespace F = torch::nn::functional;
 
-ConvBnReluImpl::ConvBnReluImpl(int in, int out, int kernel, int stride, int groups, bool relu_) : relu(relu_) {
+ConvBnReluImpl::ConvBnReluImpl(int in, int out, int kernel, int stride, int groups, bool relu_)
+    : relu(relu_), stride_(stride), padding_(kernel / 2), groups_(groups) {
   conv = register_module("conv", torch::nn::Conv2d(torch::nn::Conv2dOptions(in, out, kernel)
                                                        .stride(stride)
                                                        .padding(kernel / 2)
@@ -16,8 +17,27 @@ ConvBnReluImpl::ConvBnReluImpl(int in, int out, int kernel, int stride, int grou
   bn = register_module("bn", torch::nn::BatchNorm2d(out));
 }
 
+void ConvBnReluImpl::fold() {
+  const std::vector<torch::Tensor> from = {conv->weight, bn->weight, bn->bias, bn->running_mean, bn->running_var};
+  std::vector<std::pair<const void*, std::uint32_t>> now;
+  for (const auto& t : from) now.emplace_back(t.data_ptr(), t._version());
+  if (now == folded_from_) return;
+  torch::NoGradGuard no_grad;
+  const auto scale = bn->weight / torch::sqrt(bn->running_var + bn->options.eps());
+  folded_weight_ = conv->weight * scale.reshape({-1, 1, 1, 1});
+  folded_bias_ = bn->bias - bn->running_mean * scale;
+  folded_from_ = std::move(now);
+}
+
 torch::Tensor ConvBnReluImpl::forward(const torch::Tensor& x) {
-  auto y = bn(conv(x));
+  torch::Tensor y;
+  if (is_training()) {
+    y = bn(conv(x));
+  } else {
+    fold();
+    y = F::conv2d(x, folded_weight_,
+                  F::Conv2dFuncOptions().bias(folded_bias_).stride(stride_).padding(padding_).groups(groups_));
+  }
   return relu ? torch::relu_(y) : y;
 }
 

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
+#include <tuple>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -24,6 +26,32 @@ TEST(LwdNetwork, OutputShapesAtEveryHeadStride) {
   const auto out2 = net->forward(torch::rand({1, 6, 64, 64}));
   EXPECT_EQ(out2.head.at(8).sizes(), (std::vector<int64_t>{1, 30, 8, 8}));
   EXPECT_GT(nn::parameterCount(*net), 10000);
+}
+
+// In eval mode ConvBnRelu folds its BatchNorm into the convolution: the same output as convolution then BatchNorm,
+// for depthwise and pointwise layers, strided or not, and again after the weights or statistics change (a model
+// shared with training, or loaded).
+TEST(ConvBnRelu, FoldedBatchNormGivesTheSameOutputAndFollowsChanges) {
+  torch::manual_seed(3);
+  torch::NoGradGuard ng;
+  for (const auto& [in, out, kernel, stride, groups] :
+       std::vector<std::tuple<int, int, int, int, int>>{{8, 8, 3, 1, 8}, {8, 16, 3, 2, 8}, {8, 12, 1, 1, 1}}) {
+    nn::ConvBnRelu layer(in, out, kernel, stride, groups, /*relu=*/false);
+    auto randomise = [&] {
+      layer->conv->weight.normal_();
+      layer->bn->weight.uniform_(0.5, 2.0);
+      layer->bn->bias.normal_();
+      layer->bn->running_mean.normal_();
+      layer->bn->running_var.uniform_(0.2, 3.0);
+    };
+    randomise();
+    layer->eval();
+    const auto x = torch::randn({2, in, 20, 18});
+    const auto reference = [&] { return layer->bn(layer->conv(x)); };
+    EXPECT_TRUE(torch::allclose(layer->forward(x), reference(), 1e-4, 1e-4)) << in << " -> " << out;
+    randomise();  // in place, as an optimiser step or loading does
+    EXPECT_TRUE(torch::allclose(layer->forward(x), reference(), 1e-4, 1e-4)) << "after a change";
+  }
 }
 
 TEST(LwdNetwork, AttentionMixesDistantCells) {

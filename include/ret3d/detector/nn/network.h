@@ -3,7 +3,9 @@
 // stay free of libtorch).
 #pragma once
 
+#include <cstdint>
 #include <map>
+#include <utility>
 #include <vector>
 
 #include <torch/torch.h>
@@ -13,13 +15,21 @@
 namespace ret3d {
 namespace nn {
 
-// Conv (k x k) + BatchNorm + ReLU.
+// Conv (k x k) + BatchNorm + ReLU. In eval mode the BatchNorm is folded into the convolution (its weights scaled, a
+// bias added): one pass over the activations instead of two. The folded copy is made again whenever a weight or a
+// running statistic has changed since (the tensors' version counters), so a model shared with training stays right.
 struct ConvBnReluImpl : torch::nn::Module {
   ConvBnReluImpl(int in, int out, int kernel, int stride, int groups = 1, bool relu = true);
   torch::Tensor forward(const torch::Tensor& x);
   torch::nn::Conv2d conv{nullptr};
   torch::nn::BatchNorm2d bn{nullptr};
   bool relu;
+
+ private:
+  void fold();
+  int stride_, padding_, groups_;
+  torch::Tensor folded_weight_, folded_bias_;
+  std::vector<std::pair<const void*, std::uint32_t>> folded_from_;  // (data, version) of the tensors folded
 };
 TORCH_MODULE(ConvBnRelu);
 
