@@ -248,8 +248,7 @@ int playBag(const NodeletBenchOptions& o, const BagPlan& plan, int go_fd) {
     const ros::Duration d = t - ros::Time::now();
     if (d > ros::Duration(0)) d.sleep();
   };
-  rosbag::Bag bag;
-  openCheckedBag(bag, o.bag);  // checked again: the file may have changed since scanBag
+  rosbag::Bag bag(o.bag, rosbag::bagmode::Read);  // its layout checked by scanBag
   std::vector<std::string> topics = {plan.topic};
   if (plan.tf) topics.push_back(kTf);
   if (plan.tf_static) topics.push_back(kTfStatic);
