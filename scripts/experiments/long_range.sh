@@ -14,6 +14,7 @@ ROOT=$(pwd)
 set +u
 source scripts/env.sh
 set -u
+source scripts/experiments/refit_calibration.sh
 OUT=${OUT:-out/long}
 STAGES=${1:-1 2}
 DATA_DIR=${RET3D_SHARED_DATA:-$ROOT/../shared/data}
@@ -57,20 +58,8 @@ done
 # saved again with it (the train command once more with --resume: no step), then the relation modules behind it.
 name=$(basename "$model" .pt)
 if [ ! -f "$OUT/${name}_cal.done" ]; then
-  python3 scripts/calibration_config.py strip config/detector/lwd3d_anchor_$name.yaml "$OUT/nocal.yaml"
   rel=data/sim4_relation_urban
-  ret3d detect --data $rel --detector-model "$model" --detector-config "$OUT/nocal.yaml" --stages base \
-    --score-threshold 0.3 --out "$OUT/calib_pred" >"$OUT/calib_detect.log" 2>&1
-  python3 scripts/fit_score_calibration.py --gt $rel --pred "$OUT/calib_pred" --class Car >"$OUT/calib_car.log"
-  for c in Pedestrian Cyclist; do
-    python3 scripts/fit_score_calibration.py --gt $rel --pred "$OUT/calib_pred" --class $c --iou 0.5 --no-shape \
-      >"$OUT/calib_$c.log"
-  done
-  python3 scripts/calibration_config.py insert "$OUT/nocal.yaml" "$OUT/calibrated.yaml" "$OUT/calib_car.log" \
-    "$OUT/calib_Pedestrian.log" "$OUT/calib_Cyclist.log"
-  for f in "" .ckpt .ckpt.optim .ckpt.state; do cp "$model$f" "$OUT/${name}_cal.pt$f"; done
-  ret3d train detector "${TRAIN[@]}" --config "$OUT/calibrated.yaml" --out "$OUT/${name}_cal.pt" \
-    >"$OUT/calib_save.log" 2>&1
+  refit_calibration config/detector/lwd3d_anchor_$name.yaml "$model" "$OUT/${name}_cal.pt" "$OUT" $rel "${TRAIN[@]}"
   cp "$OUT/${name}_cal.pt" "$OUT/models/detector.pt"
   ret3d train intra --data $rel --detector "$OUT/models/detector.pt" --score-threshold 0.3 \
     --config config/relation/intra_lwd3d_m1.yaml --sequences 0-9 --val-sequences 10-11 --threads 2 \

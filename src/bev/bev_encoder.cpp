@@ -76,16 +76,18 @@ BevImage BevEncoder::encode(const PointCloud& current, const PointCloud* previou
 
 namespace {
 
-// Accumulates one sweep into the rows [v_begin, v_end) of its three channels. A worker owns a band of rows (or a
-// whole sweep), so the threads never share a cell: no locks and no merge pass.
+// One grid's part of an item: its geometry, the sweep's three channels and the rows [v_begin, v_end) to fill.
+struct Target {
+  int W, H, v_begin, v_end;
+  float x_min, y_min, z_min, z_max, inv_span, inv_res;
+  float *height, *count, *intensity;
+};
+
+// Accumulates the points of one sweep that fall in each target's rows: max height, count, max intensity. The previous
+// sweep is moved into the current frame first (transform); each point is read and moved once for every grid. A worker
+// owns a band of rows (or a whole sweep), so the threads never share a cell: no locks and no merge pass.
 void accumulateSweep(const PointCloud& cloud, const Eigen::Matrix<float, 3, 4>& T, bool transform,
-                     const BevGeometry& g, int v_begin, int v_end, float* height_ch, float* count_ch,
-                     float* intensity_ch) {
-  const int W = g.width(), H = g.height();
-  const float inv_span = static_cast<float>(1.0 / (g.z_max - g.z_min));
-  const float x_min = static_cast<float>(g.x_min), y_min = static_cast<float>(g.y_min);
-  const float z_min = static_cast<float>(g.z_min), z_max = static_cast<float>(g.z_max);
-  const float inv_res = static_cast<float>(1.0 / g.resolution);
+                     const std::vector<Target>& targets) {
   for (const Point& p : cloud.points) {
     float x = p.x, y = p.y, z = p.z;
     if (transform) {
@@ -93,19 +95,21 @@ void accumulateSweep(const PointCloud& cloud, const Eigen::Matrix<float, 3, 4>& 
       y = T(1, 0) * p.x + T(1, 1) * p.y + T(1, 2) * p.z + T(1, 3);
       z = T(2, 0) * p.x + T(2, 1) * p.y + T(2, 2) * p.z + T(2, 3);
     }
-    if (!(z >= z_min && z <= z_max)) continue;  // also drops NaN
-    const float fu = (x - x_min) * inv_res, fv = (y - y_min) * inv_res;
-    // Bounds in float before the cast: a finite but huge coordinate (1e30) does not fit an int (UB; on x86 it became
-    // INT_MIN, an index far outside the image).
-    if (!(fu >= 0.0f && fv >= 0.0f && fu < static_cast<float>(W) && fv < static_cast<float>(H))) continue;
-    const int u = static_cast<int>(fu), v = static_cast<int>(fv);
-    if (u >= W || v >= H || v < v_begin || v >= v_end) continue;
-    const std::size_t idx = static_cast<std::size_t>(v) * W + u;
-    const float h = (z - z_min) * inv_span;                        // LWD-3D eq. (1), normalised to [0, 1]
-    if (h > height_ch[idx]) height_ch[idx] = h;
-    count_ch[idx] += 1.0f;
     const float inten = std::min(1.0f, std::max(0.0f, std::isfinite(p.intensity) ? p.intensity : 0.0f));
-    if (inten > intensity_ch[idx]) intensity_ch[idx] = inten;      // LWD-3D eq. (3)
+    for (const Target& t : targets) {
+      if (!(z >= t.z_min && z <= t.z_max)) continue;  // also drops NaN
+      const float fu = (x - t.x_min) * t.inv_res, fv = (y - t.y_min) * t.inv_res;
+      // Bounds in float before the cast: a finite but huge coordinate (1e30) does not fit an int (UB; on x86 it
+      // became INT_MIN, an index far outside the image).
+      if (!(fu >= 0.0f && fv >= 0.0f && fu < static_cast<float>(t.W) && fv < static_cast<float>(t.H))) continue;
+      const int u = static_cast<int>(fu), v = static_cast<int>(fv);
+      if (u >= t.W || v >= t.H || v < t.v_begin || v >= t.v_end) continue;
+      const std::size_t idx = static_cast<std::size_t>(v) * t.W + u;
+      const float h = (z - t.z_min) * t.inv_span;                      // LWD-3D eq. (1), normalised to [0, 1]
+      if (h > t.height[idx]) t.height[idx] = h;
+      t.count[idx] += 1.0f;
+      if (inten > t.intensity[idx]) t.intensity[idx] = inten;         // LWD-3D eq. (3)
+    }
   }
 }
 
@@ -113,41 +117,58 @@ void accumulateSweep(const PointCloud& cloud, const Eigen::Matrix<float, 3, 4>& 
 
 void BevEncoder::encode(const PointCloud& current, const PointCloud* previous,
                         const Eigen::Isometry3d& prev_to_current, BevImage* out) const {
-  const BevGeometry& g = options_.geometry;
-  const int H = g.height(), W = g.width();
-  out->channels = kChannels;
-  out->height = H;
-  out->width = W;
-  const std::size_t plane = static_cast<std::size_t>(H) * W;
-  out->data.assign(plane * kChannels, 0.0f);
+  encodeAll({{this, out}}, current, previous, prev_to_current);
+}
 
+void BevEncoder::encodeAll(const std::vector<std::pair<const BevEncoder*, BevImage*>>& targets,
+                           const PointCloud& current, const PointCloud* previous,
+                           const Eigen::Isometry3d& prev_to_current) {
+  if (targets.empty()) return;
+  int min_h = 1 << 30;
+  for (const auto& [enc, out] : targets) {
+    const BevGeometry& g = enc->options_.geometry;
+    out->channels = kChannels;
+    out->height = g.height();
+    out->width = g.width();
+    out->data.assign(static_cast<std::size_t>(out->height) * out->width * kChannels, 0.0f);
+    min_h = std::min(min_h, out->height);
+  }
   const Eigen::Matrix<float, 3, 4> T = prev_to_current.matrix().topRows<3>().cast<float>();
-  const float inv_log_norm = static_cast<float>(1.0 / std::log(options_.density_norm));
-  float* base = out->data.data();
 
-  // Work items: (sweep, band of rows). With two threads and two sweeps each thread takes one whole sweep (no point
-  // is scanned twice); with one sweep the rows are split.
+  // Work items: (sweep, band of rows); each band is the same fraction of every grid's rows, so items never write the
+  // same cell. Sweeps first, so that two threads take one sweep each.
   struct Item {
-    int sweep, v_begin, v_end;
+    int sweep, band;
   };
-  const int threads = std::max(1, std::min(options_.threads, H));
+  const int threads = std::max(1, std::min(targets.front().first->options_.threads, min_h));
   const int sweeps = previous ? kSweeps : 1;
   const int bands = std::max(1, threads / sweeps);
   std::vector<Item> items;
   for (int s = 0; s < sweeps; ++s)
-    for (int b = 0; b < bands; ++b) items.push_back({s, H * b / bands, H * (b + 1) / bands});
+    for (int b = 0; b < bands; ++b) items.push_back({s, b});
 
   auto run = [&](const Item& it) {
-    const PointCloud* cloud = it.sweep == 0 ? &current : previous;
-    float* hc = base + plane * (kChannelsPerSweep * it.sweep + 0);
-    float* dc = base + plane * (kChannelsPerSweep * it.sweep + 1);
-    float* ic = base + plane * (kChannelsPerSweep * it.sweep + 2);
-    accumulateSweep(*cloud, T, it.sweep == 1, g, it.v_begin, it.v_end, hc, dc, ic);
-    // Counts -> LWD-3D eq. (2), read as min(1, log(N + 1) / log(64)) (the printed log((N+1)/64) is negative
-    // for every N < 63; MV3D's normalisation is meant).
-    const std::size_t end = static_cast<std::size_t>(it.v_end) * W;
-    for (std::size_t i = static_cast<std::size_t>(it.v_begin) * W; i < end; ++i)
-      if (dc[i] > 0) dc[i] = std::min(1.0f, std::log(dc[i] + 1.0f) * inv_log_norm);
+    std::vector<Target> parts;
+    parts.reserve(targets.size());
+    for (const auto& [enc, out] : targets) {
+      const BevGeometry& g = enc->options_.geometry;
+      const std::size_t plane = static_cast<std::size_t>(out->height) * out->width;
+      float* base = out->data.data() + plane * (kChannelsPerSweep * it.sweep);
+      parts.push_back({out->width, out->height, out->height * it.band / bands, out->height * (it.band + 1) / bands,
+                       static_cast<float>(g.x_min), static_cast<float>(g.y_min), static_cast<float>(g.z_min),
+                       static_cast<float>(g.z_max), static_cast<float>(1.0 / (g.z_max - g.z_min)),
+                       static_cast<float>(1.0 / g.resolution), base, base + plane, base + 2 * plane});
+    }
+    accumulateSweep(it.sweep == 0 ? current : *previous, T, it.sweep == 1, parts);
+    // Counts -> LWD-3D eq. (2), read as min(1, log(N + 1) / log(64)) (the printed log((N+1)/64) is negative for
+    // every N < 63; MV3D's normalisation is meant), over this item's rows of each grid.
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+      const Target& t = parts[k];
+      const float inv_log_norm = static_cast<float>(1.0 / std::log(targets[k].first->options_.density_norm));
+      const std::size_t end = static_cast<std::size_t>(t.v_end) * t.W;
+      for (std::size_t i = static_cast<std::size_t>(t.v_begin) * t.W; i < end; ++i)
+        if (t.count[i] > 0) t.count[i] = std::min(1.0f, std::log(t.count[i] + 1.0f) * inv_log_norm);
+    }
   };
   auto worker = [&](int t) {
     for (std::size_t i = t; i < items.size(); i += threads) run(items[i]);

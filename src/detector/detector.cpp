@@ -2,10 +2,14 @@
 
 #include <algorithm>
 #include <chrono>
+#include <filesystem>
+#include <numeric>
+#include <sstream>
 
 #include <torch/torch.h>
 
 #include "ret3d/bev/bev_encoder.h"
+#include "ret3d/detector/model_file.h"
 #include "ret3d/detector/nms.h"
 #include "ret3d/detector/nn/model.h"
 
@@ -21,7 +25,60 @@ struct Detector::Impl {
   std::shared_ptr<nn::DetectorModel> model;
   std::unique_ptr<BevEncoder> encoder;
   BevImage bev;
+  // The far field (inference.far_field): its model, the inference options its boxes are decoded and refined with
+  // (the near model's, but for its own score calibration), its encoder and image.
+  std::shared_ptr<nn::DetectorModel> far_model;
+  InferenceOptions far_inference;
+  PointRefineOptions far_refine_file;  // the far file's own refinement options (score calibration for its weights)
+  std::unique_ptr<BevEncoder> far_encoder;
+  BevImage far_bev;
+
+  void loadFarField(const DetectorOptions& options);
+  void setFarInference(const InferenceOptions& near);
 };
+
+namespace {
+
+std::string farModelPath(const InferenceOptions& o) {
+  const std::filesystem::path far(o.far_field->model_path);
+  if (far.is_absolute() || o.model_path.empty()) return far.string();
+  return (std::filesystem::path(o.model_path).parent_path() / far).string();
+}
+
+}  // namespace
+
+void Detector::Impl::loadFarField(const DetectorOptions& options) {
+  if (!options.inference.far_field) return;
+  const std::string path = farModelPath(options.inference);
+  // The file's own model, and the options it was trained with (for its score calibration) when it stores them.
+  const ModelFileContents file = readModelFile(path);  // names the file when it is missing or corrupt
+  DetectorOptions far;
+  if (!file.metadata.trained_with.empty())
+    far = detectorOptionsFromYaml(file.metadata.trained_with, path + " (trained_with)");
+  far.model = file.metadata.config;
+  auto fail = [&](const std::string& why) {
+    throw OptionError("inference.far_field.model_path", path, why);
+  };
+  if (far.inference.far_field) fail("the far-field model has a far field of its own");
+  if (far.model.classes != options.model.classes) fail("the far-field model detects other classes");
+  far_model = nn::DetectorModel::load(path, &far.model);
+  far_model->net->eval();
+  if (far_model->metadata().feature_dim != model->metadata().feature_dim)
+    fail("its features o_i have " + std::to_string(far_model->metadata().feature_dim) + " values, the near model's " +
+         std::to_string(model->metadata().feature_dim));
+  far_refine_file = far.inference.point_refine;
+  DetectorOptions far_grid = far;  // its own grid, with the near model's thread count
+  far_grid.inference.threads = options.inference.threads;
+  far_encoder = std::make_unique<BevEncoder>(far_grid.bevOptions());
+  setFarInference(options.inference);
+}
+
+void Detector::Impl::setFarInference(const InferenceOptions& near) {
+  far_inference = near;
+  far_inference.far_field.reset();
+  far_inference.grid_extent.reset();
+  far_inference.point_refine.score_calibration = far_refine_file.score_calibration;
+}
 
 Detector::Detector(const DetectorOptions& options) : options_(options), impl_(std::make_unique<Impl>()) {
   options_.validate();
@@ -33,6 +90,7 @@ Detector::Detector(const DetectorOptions& options) : options_(options), impl_(st
     impl_->model = nn::DetectorModel::load(options_.inference.model_path, &options_.model);
   }
   impl_->encoder = std::make_unique<BevEncoder>(options_.bevOptions());
+  impl_->loadFarField(options_);
 }
 
 Detector::Detector(const DetectorOptions& options, std::shared_ptr<nn::DetectorModel> model)
@@ -42,33 +100,71 @@ Detector::Detector(const DetectorOptions& options, std::shared_ptr<nn::DetectorM
   options_.validate();
   impl_->model = std::move(model);
   impl_->encoder = std::make_unique<BevEncoder>(options_.bevOptions());
+  impl_->loadFarField(options_);
 }
 
 Detector::~Detector() = default;
 
 int Detector::featureDim() const { return impl_->model->metadata().feature_dim; }
-std::int64_t Detector::parameterCount() const { return nn::parameterCount(*impl_->model->net); }
+std::int64_t Detector::parameterCount() const {
+  return nn::parameterCount(*impl_->model->net) + (impl_->far_model ? nn::parameterCount(*impl_->far_model->net) : 0);
+}
+bool Detector::hasFarField() const { return impl_->far_model != nullptr; }
+
+std::string Detector::describeGrids() const {
+  std::string s = impl_->encoder->geometry().describe();
+  if (!impl_->far_model) return s;
+  std::ostringstream far;
+  far << s << " near field; far field " << farModelPath(options_.inference) << ": "
+      << impl_->far_encoder->geometry().describe() << " beyond " << options_.inference.far_field->margin
+      << " m inside the near field's edge";
+  return far.str();
+}
 nn::DetectorModel& Detector::model() { return *impl_->model; }
 
 Detections Detector::detect(const PointCloud& current, const PointCloud* previous,
                             const Eigen::Isometry3d& prev_to_current) {
+  Impl& im = *impl_;
+  const bool far = im.far_model != nullptr;
   auto t0 = std::chrono::steady_clock::now();
-  impl_->encoder->encode(current, previous, prev_to_current, &impl_->bev);
+  if (far)
+    BevEncoder::encodeAll({{im.encoder.get(), &im.bev}, {im.far_encoder.get(), &im.far_bev}}, current, previous,
+                          prev_to_current);
+  else
+    im.encoder->encode(current, previous, prev_to_current, &im.bev);
   timings_.bev_ms = msSince(t0);
 
   torch::NoGradGuard no_grad;
-  auto& model = *impl_->model;
+  auto& model = *im.model;
   const bool was_training = model.net->is_training();
   model.net->eval();
   t0 = std::chrono::steady_clock::now();
   // from_blob without a copy: the image outlives the forward pass.
-  auto input = torch::from_blob(impl_->bev.data.data(), {1, impl_->bev.channels, impl_->bev.height, impl_->bev.width});
-  const nn::NetworkOutput out = model.forward(input);
+  auto forward = [](nn::DetectorModel& m, BevImage& bev) {
+    return m.forward(torch::from_blob(bev.data.data(), {1, bev.channels, bev.height, bev.width}));
+  };
+  const nn::NetworkOutput out = forward(model, im.bev);
+  nn::NetworkOutput far_out;
+  if (far) far_out = forward(*im.far_model, im.far_bev);
   timings_.network_ms = msSince(t0);
 
   t0 = std::chrono::steady_clock::now();
-  const BevGeometry& g = impl_->encoder->geometry();  // the grid just encoded (inference.grid_extent applied)
+  const BevGeometry& g = im.encoder->geometry();  // the grid just encoded (inference.grid_extent applied)
   std::vector<Box> candidates = model.head().decode(out, 0, g, options_.inference);
+  // The near field owns the boxes centred inside its grid shrunk by the margin, the far model every other one:
+  // candidates [0, n_near) are the near model's.
+  const double m = far ? options_.inference.far_field->margin : 0.0;
+  auto near_owns = [&](const Box& b) {
+    return b.x >= g.x_min + m && b.x < g.x_max - m && b.y >= g.y_min + m && b.y < g.y_max - m;
+  };
+  std::size_t n_near = candidates.size();
+  if (far) {
+    candidates.erase(std::remove_if(candidates.begin(), candidates.end(), [&](const Box& b) { return !near_owns(b); }),
+                     candidates.end());
+    n_near = candidates.size();
+    for (Box& b : im.far_model->head().decode(far_out, 0, im.far_encoder->geometry(), im.far_inference))
+      if (!near_owns(b)) candidates.push_back(b);
+  }
   timings_.decode_ms = msSince(t0);
 
   t0 = std::chrono::steady_clock::now();
@@ -84,17 +180,49 @@ Detections Detector::detect(const PointCloud& current, const PointCloud* previou
   timings_.nms_ms = msSince(t0);
 
   t0 = std::chrono::steady_clock::now();
-  if (options_.inference.point_refine.enabled()) refineBoxesFromPoints(current, &det.boxes, options_.inference.point_refine);
-  headingFromVelocity(&det.boxes, options_.inference.heading_from_velocity);
+  // Each box refined and scored by its own model's options: the near model's first, then the far model's.
+  std::vector<Box> far_boxes;
+  for (std::size_t k = 0; k < keep.size(); ++k)
+    if (keep[k] >= n_near) far_boxes.push_back(det.boxes[k]);
+  if (!far_boxes.empty()) {
+    std::size_t w = 0;
+    for (std::size_t k = 0; k < keep.size(); ++k)
+      if (keep[k] < n_near) det.boxes[w++] = det.boxes[k];
+    det.boxes.resize(w);
+  }
+  const InferenceOptions& o = options_.inference;
+  if (o.point_refine.enabled()) refineBoxesFromPoints(current, &det.boxes, o.point_refine);
+  headingFromVelocity(&det.boxes, o.heading_from_velocity);
+  if (!far_boxes.empty()) {
+    if (im.far_inference.point_refine.enabled()) refineBoxesFromPoints(current, &far_boxes, im.far_inference.point_refine);
+    headingFromVelocity(&far_boxes, im.far_inference.heading_from_velocity);
+  }
   // Calibrated classes were let in below score_threshold (candidate_threshold): their final scores decide.
-  const float min_score = options_.inference.score_threshold;
-  det.boxes.erase(std::remove_if(det.boxes.begin(), det.boxes.end(), [&](const Box& b) { return b.score < min_score; }),
-                  det.boxes.end());
+  const float min_score = o.score_threshold;
+  auto low = [&](const Box& b) { return b.score < min_score; };
+  det.boxes.erase(std::remove_if(det.boxes.begin(), det.boxes.end(), low), det.boxes.end());
+  far_boxes.erase(std::remove_if(far_boxes.begin(), far_boxes.end(), low), far_boxes.end());
   timings_.refine_ms = msSince(t0);
 
-  // The features o_i belong to decoding (Ret3D §3.1): timed with it.
+  // The features o_i belong to decoding (Ret3D §3.1): timed with it. Each box's from its own model's map; the boxes
+  // then ordered by descending score, their feature rows with them.
   t0 = std::chrono::steady_clock::now();
-  const auto f = nn::sampleFeatures(out.features[0], det.boxes, g, options_.model.featureStride());
+  torch::Tensor f = nn::sampleFeatures(out.features[0], det.boxes, g, options_.model.featureStride());
+  if (far) {
+    const torch::Tensor ff =
+        nn::sampleFeatures(far_out.features[0], far_boxes, im.far_encoder->geometry(), im.far_model->config().featureStride());
+    f = torch::cat({f, ff}, 0);
+    det.boxes.insert(det.boxes.end(), far_boxes.begin(), far_boxes.end());
+    std::vector<std::int64_t> order(det.boxes.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::int64_t a, std::int64_t b) { return det.boxes[a].score > det.boxes[b].score; });
+    std::vector<Box> sorted;
+    sorted.reserve(order.size());
+    for (std::int64_t i : order) sorted.push_back(det.boxes[i]);
+    det.boxes = std::move(sorted);
+    f = f.index_select(0, torch::tensor(order, torch::kLong)).contiguous();
+  }
   det.feature_dim = static_cast<std::size_t>(f.size(1));
   det.features.assign(f.data_ptr<float>(), f.data_ptr<float>() + f.numel());
   timings_.decode_ms += msSince(t0);
@@ -108,6 +236,7 @@ void Detector::setThresholds(double score_threshold, double nms_iou) {
   next.nms_iou = nms_iou;
   next.validate();
   options_.inference = next;
+  if (impl_->far_model) impl_->setFarInference(options_.inference);
 }
 
 }  // namespace ret3d

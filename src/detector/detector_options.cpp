@@ -101,6 +101,10 @@ void InferenceOptions::validate() const {
   for (const auto& [c, speed] : heading_from_velocity)
     checkOption(std::string("heading_from_velocity.") + className(c), speed, kHeadingSpeed);
   if (grid_extent) GridExtent::fromValues(grid_extent->values());
+  if (far_field) {
+    if (far_field->model_path.empty()) throw OptionError("far_field.model_path", "", "must name a model file");
+    checkOption("far_field.margin", far_field->margin, FarFieldOptions::kMargin);
+  }
   try {
     point_refine.validate();
   } catch (const std::invalid_argument& e) {
@@ -252,6 +256,14 @@ void readInference(YamlReader r, InferenceOptions* o) {
     } catch (const OptionError& e) {
       r.fail(e.key(), e.reason() + ", got " + e.value());
     }
+  }
+  if (r.has("far_field")) {
+    YamlReader f = r.child("far_field");
+    FarFieldOptions far;
+    f.get("model_path", &far.model_path);
+    f.get("margin", &far.margin);
+    f.finish();
+    o->far_field = far;
   }
   {
     YamlReader p = r.child("point_refine");

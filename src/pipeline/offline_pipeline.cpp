@@ -102,7 +102,7 @@ OfflinePipeline::OfflinePipeline(const PipelineConfig& c) : stages_(c.stages) {
     }
     detector_ = std::make_unique<Detector>(o);
     desc << "; detector " << path << " (" << headTypeName(o.model.head) << " head, " << detector_->parameterCount()
-         << " parameters, score >= " << o.inference.score_threshold << ", grid " << o.inferenceGeometry().describe() << ")";
+         << " parameters, score >= " << o.inference.score_threshold << ", grid " << detector_->describeGrids() << ")";
   }
   if (has(stages_, "intra")) {
     const std::string path =

@@ -58,7 +58,7 @@ class DetectorNodelet : public StageNodelet<sensor_msgs::PointCloud2> {
     NODELET_INFO_STREAM("detector warmed up in "
                         << std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()
                         << " s (3 synthetic scans of 120k points); grid "
-                        << detector_->options().inferenceGeometry().describe());
+                        << detector_->describeGrids());
   }
 
   // dynamic_reconfigure (cfg/Detector.cfg): the score threshold and the NMS IoU change between clouds. The server

@@ -139,18 +139,46 @@ TEST(BevEncoder, PreviousSweepIsMovedIntoTheCurrentFrame) {
   EXPECT_FLOAT_EQ(enc.encode(cur, &prev, T).at(3, 4, 11), 1.5f / 4.0f);
 }
 
-TEST(BevEncoder, ThreadCountDoesNotChangeTheResult) {
+// Two sweeps of 20,000 points each, uniform over x +-sx, y +-sy, z +-2.5 m (a fixed generator: same on every machine).
+std::pair<PointCloud, PointCloud> randomSweeps(std::uint32_t seed, float sx, float sy) {
   PointCloud cur, prev;
-  std::uint32_t s = 12345;
-  auto rnd = [&]() { s = s * 1664525u + 1013904223u; return (s >> 8) / 16777216.0f; };
-  for (int i = 0; i < 20000; ++i) cur.push_back({rnd() * 9 - 4.5f, rnd() * 5 - 2.5f, rnd() * 5 - 2.5f, rnd()});
-  for (int i = 0; i < 20000; ++i) prev.push_back({rnd() * 9 - 4.5f, rnd() * 5 - 2.5f, rnd() * 5 - 2.5f, rnd()});
+  auto rnd = [&]() { seed = seed * 1664525u + 1013904223u; return (seed >> 8) / 16777216.0f; };
+  for (PointCloud* c : {&cur, &prev})
+    for (int i = 0; i < 20000; ++i) c->push_back({(rnd() * 2 - 1) * sx, (rnd() * 2 - 1) * sy, rnd() * 5 - 2.5f, rnd()});
+  return {cur, prev};
+}
+
+TEST(BevEncoder, ThreadCountDoesNotChangeTheResult) {
+  const auto [cur, prev] = randomSweeps(12345, 4.5f, 2.5f);
   const Eigen::Isometry3d T(Eigen::Translation3d(0.3, -0.2, 0.1));
   const BevImage a = BevEncoder(smallGrid(1)).encode(cur, &prev, T);
   const BevImage b = BevEncoder(smallGrid(2)).encode(cur, &prev, T);
   const BevImage c = BevEncoder(smallGrid(3)).encode(cur, &prev, T);
   EXPECT_EQ(a.data, b.data);
   EXPECT_EQ(a.data, c.data);
+}
+
+// The two-resolution detector encodes its near and far grids in one pass: each image is the one its encoder makes
+// alone, whatever the thread count, with and without a previous sweep.
+TEST(BevEncoder, SeveralGridsAtOnceGiveEachGridsOwnImage) {
+  const auto [cur, prev] = randomSweeps(777, 10, 5);
+  const Eigen::Isometry3d T(Eigen::Translation3d(0.3, -0.2, 0.1));
+  for (int threads : {1, 2, 3}) {
+    BevEncoderOptions near = smallGrid(threads), far = smallGrid(threads);
+    far.geometry.x_min = -10, far.geometry.x_max = 10, far.geometry.y_min = -5, far.geometry.y_max = 5;
+    far.geometry.z_min = -1.5;
+    far.geometry.resolution = 1.25;  // 16 x 8 cells of a grid 2.5 times as large
+    far.density_norm = 16;
+    const BevEncoder a(near), b(far);
+    for (const PointCloud* p : {static_cast<const PointCloud*>(nullptr), &prev}) {
+      BevImage ia, ib;
+      BevEncoder::encodeAll({{&a, &ia}, {&b, &ib}}, cur, p, T);
+      EXPECT_EQ(ia.data, a.encode(cur, p, T).data) << threads;
+      EXPECT_EQ(ib.data, b.encode(cur, p, T).data) << threads;
+      EXPECT_EQ(ib.width, 16);
+      EXPECT_NE(ia.data, ib.data);
+    }
+  }
 }
 
 // Real HDL-64E scans fill the grid; prints the encode time against the 5 ms target (printed, never asserted).

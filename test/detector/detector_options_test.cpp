@@ -104,6 +104,27 @@ TEST(DetectorOptions, TheInferenceGridExtentIsReadAndChecked) {
   refused("inference: {grid_extent: [80, -80, -48, 48]}", "x_max must exceed x_min");
 }
 
+TEST(DetectorOptions, TheFarFieldIsReadAndChecked) {
+  const auto o = detectorOptionsFromYaml(
+      "inference: {grid_extent: [-32, 32, -32, 32], far_field: {model_path: detector_far.pt, margin: 1.5}}\n");
+  ASSERT_TRUE(o.inference.far_field);
+  EXPECT_EQ(o.inference.far_field->model_path, "detector_far.pt");
+  EXPECT_DOUBLE_EQ(o.inference.far_field->margin, 1.5);
+  EXPECT_EQ(o.inferenceGeometry().width(), 256);  // the near field: the grid this model's network runs on
+  EXPECT_FALSE(detectorOptionsFromYaml("{}").inference.far_field);
+  auto refused = [](const std::string& yaml, const std::string& words) {
+    try {
+      detectorOptionsFromYaml(yaml);
+      ADD_FAILURE() << "accepted: " << yaml;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+    }
+  };
+  refused("inference: {far_field: {margin: 2}}", "far_field.model_path");
+  refused("inference: {far_field: {model_path: f.pt, margin: -1}}", "far_field.margin");
+  refused("inference: {far_field: {model_path: f.pt, margins: 1}}", "margins");
+}
+
 TEST(DetectorOptions, ModelConfigRoundTripsAndDiffsReadably) {
   ModelConfig m;
   m.head = HeadType::Anchor;

@@ -316,6 +316,60 @@ TEST(DetectorFarField, BoxesBeyond48mComeOutWhereTheObjectsAre) {
   EXPECT_EQ(placed, total);
   EXPECT_GE(overlapping, total - 3);
   EXPECT_EQ(near_boxes, 0);
+
+  // The two-resolution detector (inference.far_field): this model as the far field of a near model of finer cells
+  // whose grid lies over part of the scene (x 56-72 m; an untrained network, so its boxes there are noise). Outside
+  // the near field shrunk by the margin every box of the far model comes out as its own, with its feature row; inside
+  // it none does.
+  DetectorOptions two = tinyOptions(HeadType::Anchor);
+  two.inference.grid_extent = GridExtent{56, 72, -16, 16};
+  two.inference.far_field = FarFieldOptions{std::filesystem::absolute(job.out_model).string(), 2.0};
+  Detector both(two);
+  ASSERT_TRUE(both.hasFarField());
+  DetectorOptions near_only = two;
+  near_only.inference.far_field.reset();
+  EXPECT_EQ(both.parameterCount(), Detector(near_only).parameterCount() + detector.parameterCount());
+  auto owned = [](const Box& b) { return b.x >= 58 && b.x < 70 && b.y >= -14 && b.y < 14; };
+  auto same = [](const Box& a, const Box& b) {
+    return a.label == b.label && std::abs(a.x - b.x) < 1e-4 && std::abs(a.y - b.y) < 1e-4 &&
+           std::abs(a.yaw - b.yaw) < 1e-4 && std::abs(a.score - b.score) < 1e-5;
+  };
+  int far_kept = 0, far_dropped = 0;
+  for (int f = 0; f < kFrames; ++f) {
+    const PointCloud* prev = f > 0 ? &scene.clouds[f - 1] : nullptr;
+    const Detections alone = detector.detect(scene.clouds[f], prev, Eigen::Isometry3d::Identity());
+    const Detections d = both.detect(scene.clouds[f], prev, Eigen::Isometry3d::Identity());
+    ASSERT_EQ(d.feature_dim, alone.feature_dim);
+    ASSERT_EQ(d.features.size(), d.boxes.size() * d.feature_dim);
+    for (std::size_t k = 1; k < d.boxes.size(); ++k) EXPECT_GE(d.boxes[k - 1].score, d.boxes[k].score);
+    for (std::size_t i = 0; i < alone.boxes.size(); ++i) {
+      const Box& a = alone.boxes[i];
+      const auto match = std::find_if(d.boxes.begin(), d.boxes.end(), [&](const Box& b) { return same(b, a); });
+      if (owned(a)) {
+        ++far_dropped;
+        EXPECT_EQ(match, d.boxes.end()) << "frame " << f << ": a far box inside the near field at x " << a.x;
+        continue;
+      }
+      ++far_kept;
+      ASSERT_NE(match, d.boxes.end()) << "frame " << f << ": the far box at x " << a.x << " y " << a.y << " is missing";
+      const std::size_t k = static_cast<std::size_t>(match - d.boxes.begin());
+      for (std::size_t j = 0; j < d.feature_dim; ++j)
+        ASSERT_FLOAT_EQ(d.features[k * d.feature_dim + j], alone.features[i * alone.feature_dim + j]);
+    }
+  }
+  std::printf("  two resolutions: %d far boxes kept outside the near field, %d inside it left to the near model\n",
+              far_kept, far_dropped);
+  EXPECT_GT(far_kept, 0);
+  EXPECT_GT(far_dropped, 0);
+
+  DetectorOptions missing = two;
+  missing.inference.far_field->model_path = dir / "none.ret3d";
+  try {
+    Detector bad(missing);
+    ADD_FAILURE() << "a missing far-field model was accepted";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("none.ret3d"), std::string::npos) << e.what();
+  }
 }
 
 TEST(DetectorDataset, VelocitiesFromTrackIdsAndEgoMotion) {

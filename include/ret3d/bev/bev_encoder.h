@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -81,6 +82,10 @@ class BevEncoder {
   // The same into an existing image (resized when needed), avoiding the allocation per frame.
   void encode(const PointCloud& current, const PointCloud* previous, const Eigen::Isometry3d& prev_to_current,
               BevImage* out) const;
+  // Several grids of the same sweeps at once (the two-resolution detector's near and far fields): one pass over the
+  // points fills every image, with the first encoder's thread count. The same images as encoding each alone.
+  static void encodeAll(const std::vector<std::pair<const BevEncoder*, BevImage*>>& targets, const PointCloud& current,
+                        const PointCloud* previous, const Eigen::Isometry3d& prev_to_current);
 
  private:
   BevEncoderOptions options_;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <memory>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -49,7 +50,11 @@ class Detector {
   void setThresholds(double score_threshold, double nms_iou);
   const DetectorTimings& lastTimings() const { return timings_; }
   int featureDim() const;
-  std::int64_t parameterCount() const;
+  std::int64_t parameterCount() const;  // both models' with a far field
+  bool hasFarField() const;             // inference.far_field loaded
+  // The grid(s) the networks run on: "x [-48, 48] y [-48, 48] z [-3, 1] res 0.25 (384 x 384)", with a far field
+  // "... near field; far field FILE: x [-80, 80] ... (320 x 192) beyond 2 m inside the near field's edge".
+  std::string describeGrids() const;
   nn::DetectorModel& model();
 
  private:

@@ -85,6 +85,18 @@ struct GridExtent {
   BevGeometry appliedTo(BevGeometry g) const;
 };
 
+// The two-resolution detector (issue 20): a second model, trained on coarser cells over more ground (e.g. x +-80,
+// y +-48 m in 0.5 m cells, config/detector/lwd3d_anchor_far.yaml), runs beside this one. This model's network keeps
+// its fine cells over the near field (its grid, or inference.grid_extent); a box whose centre lies inside the near
+// field shrunk by `margin` on every side comes from it, any other box from the far model's. Their candidates meet in
+// one NMS, and each box is refined and scored by the options of the model it came from (the far model's score
+// calibration is its own, from its file). So far cars cost the coarse cells' time, and near ones keep the fine cells.
+struct FarFieldOptions {
+  std::string model_path;  // a detector model file; a relative path is relative to the near model file's folder
+  double margin = 2.0;     // m: near-field boxes this close to its edge (cut off there, seen without context) yield
+  static constexpr OptionRange kMargin{0, 20};
+};
+
 struct InferenceOptions {
   std::string model_path;      // empty: the network is freshly initialised (tests, training)
   int threads = 2;             // torch intra-op threads and BEV workers
@@ -114,6 +126,8 @@ struct InferenceOptions {
   // come from a convolution), so a trained model may cover more ground than it was trained on, at a cost
   // proportional to the area; the resolution and the heights stay the model's.
   std::optional<GridExtent> grid_extent;
+  // A far-field model beside this one (FarFieldOptions); none = this model alone.
+  std::optional<FarFieldOptions> far_field;
 
   // The one allowed range of each number: YAML, the detector nodelet's parameters, cfg/Detector.cfg (a test keeps
   // its ranges equal to these) and the command line all check these.
