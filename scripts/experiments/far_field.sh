@@ -60,7 +60,8 @@ fi
 # 4. Validation (seeds 5000-5001 of the current simulator), whole pipeline and base detector: the default, the pair.
 row() {  # name stages models
   local n=$1 stages=$2 m=$3
-  EVAL_DATA=$VAL scripts/experiments/eval_heldout.sh "$stages" "far_val_$n" --models "$m" >"$OUT/val_$n.log" 2>&1
+  [ -f "out/heldout/far_val_$n/eval/metrics.json" ] ||
+    EVAL_DATA=$VAL scripts/experiments/eval_heldout.sh "$stages" "far_val_$n" --models "$m" >"$OUT/val_$n.log" 2>&1
   python3 - "out/heldout/far_val_$n" "$n" <<'PY'
 import json, os, sys
 o, n = sys.argv[1:]

@@ -9,6 +9,7 @@
 #include <torch/torch.h>
 
 #include "ret3d/bev/bev_encoder.h"
+#include "ret3d/core/geometry.h"
 #include "ret3d/detector/model_file.h"
 #include "ret3d/detector/nms.h"
 #include "ret3d/detector/nn/model.h"
@@ -151,46 +152,50 @@ Detections Detector::detect(const PointCloud& current, const PointCloud* previou
   t0 = std::chrono::steady_clock::now();
   const BevGeometry& g = im.encoder->geometry();  // the grid just encoded (inference.grid_extent applied)
   std::vector<Box> candidates = model.head().decode(out, 0, g, options_.inference);
-  // The near field owns the boxes centred inside its grid shrunk by the margin, the far model every other one:
-  // candidates [0, n_near) are the near model's.
+  // With a far field the near model owns the boxes centred inside its grid shrunk by the margin, the far model every
+  // other one. Each model's candidates go through NMS and voting on their own (the far model's outside the near field
+  // only), so that inside the near field the boxes are the near model's as if it ran alone.
   const double m = far ? options_.inference.far_field->margin : 0.0;
   auto near_owns = [&](const Box& b) {
     return b.x >= g.x_min + m && b.x < g.x_max - m && b.y >= g.y_min + m && b.y < g.y_max - m;
   };
-  std::size_t n_near = candidates.size();
+  std::vector<Box> far_candidates;
   if (far) {
-    candidates.erase(std::remove_if(candidates.begin(), candidates.end(), [&](const Box& b) { return !near_owns(b); }),
-                     candidates.end());
-    n_near = candidates.size();
     for (Box& b : im.far_model->head().decode(far_out, 0, im.far_encoder->geometry(), im.far_inference))
-      if (!near_owns(b)) candidates.push_back(b);
+      if (!near_owns(b)) far_candidates.push_back(b);
   }
   timings_.decode_ms = msSince(t0);
 
   t0 = std::chrono::steady_clock::now();
-  const auto keep = rotatedNms(candidates, options_.inference.nms_iou, true,
-                               static_cast<std::size_t>(std::max(0, options_.inference.max_detections)));
+  const InferenceOptions& o = options_.inference;
+  auto suppress = [&](const std::vector<Box>& c) {
+    const auto keep = rotatedNms(c, o.nms_iou, true, static_cast<std::size_t>(std::max(0, o.max_detections)));
+    if (o.nms_voting_iou > 0) return voteBoxes(c, keep, o.nms_voting_iou);
+    std::vector<Box> kept;
+    kept.reserve(keep.size());
+    for (std::size_t i : keep) kept.push_back(c[i]);
+    return kept;
+  };
   Detections det;
-  if (options_.inference.nms_voting_iou > 0) {
-    det.boxes = voteBoxes(candidates, keep, options_.inference.nms_voting_iou);
-  } else {
-    det.boxes.reserve(keep.size());
-    for (std::size_t i : keep) det.boxes.push_back(candidates[i]);
+  det.boxes = suppress(candidates);
+  std::vector<Box> far_boxes;
+  if (far) {
+    det.boxes.erase(std::remove_if(det.boxes.begin(), det.boxes.end(), [&](const Box& b) { return !near_owns(b); }),
+                    det.boxes.end());
+    far_boxes = suppress(far_candidates);
+    // A far box overlapping a near one of its class across the boundary yields to it, as NMS would have it.
+    far_boxes.erase(std::remove_if(far_boxes.begin(), far_boxes.end(),
+                                   [&](const Box& f) {
+                                     return std::any_of(det.boxes.begin(), det.boxes.end(), [&](const Box& n) {
+                                       return n.label == f.label && bevIoU(n, f) > o.nms_iou;
+                                     });
+                                   }),
+                    far_boxes.end());
   }
   timings_.nms_ms = msSince(t0);
 
   t0 = std::chrono::steady_clock::now();
-  // Each box refined and scored by its own model's options: the near model's first, then the far model's.
-  std::vector<Box> far_boxes;
-  for (std::size_t k = 0; k < keep.size(); ++k)
-    if (keep[k] >= n_near) far_boxes.push_back(det.boxes[k]);
-  if (!far_boxes.empty()) {
-    std::size_t w = 0;
-    for (std::size_t k = 0; k < keep.size(); ++k)
-      if (keep[k] < n_near) det.boxes[w++] = det.boxes[k];
-    det.boxes.resize(w);
-  }
-  const InferenceOptions& o = options_.inference;
+  // Each box refined and scored by its own model's options.
   if (o.point_refine.enabled()) refineBoxesFromPoints(current, &det.boxes, o.point_refine);
   headingFromVelocity(&det.boxes, o.heading_from_velocity);
   if (!far_boxes.empty()) {
