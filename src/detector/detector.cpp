@@ -27,10 +27,10 @@ struct Detector::Impl {
   std::unique_ptr<BevEncoder> encoder;
   BevImage bev;
   // The far field (inference.far_field): its model, the inference options its boxes are decoded and refined with
-  // (the near model's, but for its own score calibration), its encoder and image.
+  // (the near model's, but for the score calibration of its own weights, from its file), its encoder and image.
   std::shared_ptr<nn::DetectorModel> far_model;
   InferenceOptions far_inference;
-  PointRefineOptions far_refine_file;  // the far file's own refinement options (score calibration for its weights)
+  decltype(PointRefineOptions::score_calibration) far_calibration;
   std::unique_ptr<BevEncoder> far_encoder;
   BevImage far_bev;
 
@@ -67,7 +67,7 @@ void Detector::Impl::loadFarField(const DetectorOptions& options) {
   if (far_model->metadata().feature_dim != model->metadata().feature_dim)
     fail("its features o_i have " + std::to_string(far_model->metadata().feature_dim) + " values, the near model's " +
          std::to_string(model->metadata().feature_dim));
-  far_refine_file = far.inference.point_refine;
+  far_calibration = far.inference.point_refine.score_calibration;
   DetectorOptions far_grid = far;  // its own grid, with the near model's thread count
   far_grid.inference.threads = options.inference.threads;
   far_encoder = std::make_unique<BevEncoder>(far_grid.bevOptions());
@@ -78,7 +78,7 @@ void Detector::Impl::setFarInference(const InferenceOptions& near) {
   far_inference = near;
   far_inference.far_field.reset();
   far_inference.grid_extent.reset();
-  far_inference.point_refine.score_calibration = far_refine_file.score_calibration;
+  far_inference.point_refine.score_calibration = far_calibration;
 }
 
 Detector::Detector(const DetectorOptions& options) : options_(options), impl_(std::make_unique<Impl>()) {
@@ -161,8 +161,8 @@ Detections Detector::detect(const PointCloud& current, const PointCloud* previou
   };
   std::vector<Box> far_candidates;
   if (far) {
-    for (Box& b : im.far_model->head().decode(far_out, 0, im.far_encoder->geometry(), im.far_inference))
-      if (!near_owns(b)) far_candidates.push_back(b);
+    far_candidates = im.far_model->head().decode(far_out, 0, im.far_encoder->geometry(), im.far_inference);
+    far_candidates.erase(std::remove_if(far_candidates.begin(), far_candidates.end(), near_owns), far_candidates.end());
   }
   timings_.decode_ms = msSince(t0);
 

@@ -8,11 +8,8 @@
 #include <sstream>
 #include <stdexcept>
 
-#include <yaml-cpp/yaml.h>
-
 #include "ret3d/detector/detector.h"
 #include "ret3d/detector/model_file.h"
-#include "tools/pipeline_options.h"
 #include "tools/train_command.h"
 
 namespace ret3d {
@@ -22,8 +19,8 @@ namespace {
 // The near model's config text with `inference:` given the near field and the far field. The keys are written into
 // the text (its comments, which say how the model was made, are kept); a config that sets either already is refused.
 std::string withFarField(const std::string& text, const std::string& origin, const GridExtent& near, double margin) {
-  const YAML::Node doc = YAML::Load(text);
-  if (doc["inference"] && (doc["inference"]["grid_extent"] || doc["inference"]["far_field"]))
+  const InferenceOptions given = detectorOptionsFromYaml(text, origin).inference;
+  if (given.grid_extent || given.far_field)
     throw std::runtime_error(origin + ": its config sets inference.grid_extent or inference.far_field already");
   std::ostringstream keys;
   keys << "  # the two-resolution detector (ret3d train far-field): this network over the near field, beside\n"
@@ -74,9 +71,8 @@ CommandRun setup(CLI::App& app) {
     std::filesystem::create_directories(*out);
     const std::string near_out = (std::filesystem::path(*out) / "detector.pt").string();
     const std::string far_out = (std::filesystem::path(*out) / "detector_far.pt").string();
-    if (std::filesystem::exists(far_out) && std::filesystem::equivalent(*far, far_out) == false)
-      std::filesystem::remove(far_out);
-    if (!std::filesystem::exists(far_out)) std::filesystem::copy_file(*far, far_out);
+    if (!std::filesystem::exists(far_out) || !std::filesystem::equivalent(*far, far_out))
+      std::filesystem::copy_file(*far, far_out, std::filesystem::copy_options::overwrite_existing);
     writeModelFile(near_out, m, file.weights);
     const Detector detector(detectorOptionsForModel(near_out));  // loads both, as the pipeline will
     std::cout << near_out << ": " << detector.parameterCount() << " parameters; grid " << detector.describeGrids()
