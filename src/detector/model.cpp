@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 
 namespace ret3d {
 namespace nn {
@@ -72,7 +73,17 @@ std::unique_ptr<DetectorModel> DetectorModel::load(const std::string& path, cons
   if (m.in_channels != BevEncoder::kChannels)
     throw ModelFileError(path + ": the model reads " + std::to_string(m.in_channels) +
                          " BEV channels, this build encodes " + std::to_string(BevEncoder::kChannels));
-  auto model = std::make_unique<DetectorModel>(m.config, m.anchors);
+  // The metadata may describe a network that cannot be built (an anchor at a stride the head lacks, ...): the
+  // refusal names the file like every other.
+  std::unique_ptr<DetectorModel> model;
+  try {
+    model = std::make_unique<DetectorModel>(m.config, m.anchors);
+  } catch (const std::invalid_argument& e) {
+    throw ModelFileError(path + ": the metadata describes a network that cannot be built: " + e.what());
+  } catch (const c10::Error& e) {
+    throw ModelFileError(path + ": the metadata describes a network that cannot be built: " +
+                         e.what_without_backtrace());
+  }
   if (model->metadata().feature_dim != m.feature_dim || parameterCount(*model->net) != m.parameter_count)
     throw ModelFileError(path + ": the metadata describes " + std::to_string(m.parameter_count) +
                          " parameters, the network built from it has " +

@@ -97,6 +97,21 @@ TEST(ModelFile, OtherMetadataIsRefusedSayingWhatDiffers) {
   EXPECT_THROW(Detector{o}, ModelFileError);
 }
 
+// A file whose metadata describes a network that cannot be built (here an anchor at a stride the head lacks, as
+// fuzz_smoke found) is refused like any other bad file: a ModelFileError that names the file.
+TEST(ModelFile, MetadataForANetworkThatCannotBeBuiltIsRefusedNamingTheFile) {
+  test::TempDir dir;
+  const std::string path = dir / "m.ret3d";
+  nn::DetectorModel(smallModel(HeadType::Anchor)).save(path);
+  ModelFileContents file = readModelFile(path);
+  ASSERT_FALSE(file.metadata.anchors.empty());
+  file.metadata.anchors.front().stride = 1;
+  writeModelFile(path, file.metadata, file.weights);
+  const std::string m = test::errorMessage<ModelFileError>([&] { nn::DetectorModel::load(path); });
+  EXPECT_NE(m.find(path), std::string::npos) << m;
+  EXPECT_NE(m.find("stride 1"), std::string::npos) << m;
+}
+
 TEST(ModelFile, AModelThatAddsIoUQualityStartsFromTheWeightsOfOneWithout) {
   test::TempDir dir;
   const std::string path = dir / "m.ret3d";
