@@ -17,6 +17,9 @@ namespace {
 
 constexpr char kGtMagic[] = "RET3DGTDB1";
 constexpr double kFarRange = 80.0;  // the HDL-64E's maximum range in the KITTI scans
+// Where an object's returns were in the previous sweep: its box moved back by its velocity over one sweep of a 10 Hz
+// sensor (the cut region's margin absorbs other rates).
+constexpr double kSweepDt = 0.1;
 
 // Keeps the points (and their time and ring) for which keep(point) holds.
 template <typename Pred>
@@ -185,6 +188,13 @@ void SensorAugmenter::apply(DetectorSample* s, std::mt19937* rng) const {
     ignoreEmptied(s, before, o_.min_box_points);
   }
 
+  if (o_.object_intensity_probability > 0) {
+    const double lo = std::log(o_.object_intensity_gain_min), hi = std::log(o_.object_intensity_gain_max);
+    const std::vector<Box> objects = s->boxes;  // pasted ones too
+    for (const Box& b : objects)
+      if (chance(o_.object_intensity_probability))
+        scaleObjectIntensity(s, b, std::exp(lo + (hi - lo) * U(*rng)), kSweepDt);
+  }
   if (chance(o_.intensity_jitter_probability)) {
     const double scale = o_.intensity_scale_min + (o_.intensity_scale_max - o_.intensity_scale_min) * U(*rng);
     const double gamma = o_.intensity_gamma_min + (o_.intensity_gamma_max - o_.intensity_gamma_min) * U(*rng);
@@ -325,6 +335,24 @@ void zeroIntensities(PointCloud* cloud, double fraction, std::mt19937* rng) {
   std::nth_element(keys.begin(), keys.begin() + static_cast<std::ptrdiff_t>(m), keys.end(),
                    [](const auto& a, const auto& b) { return a.first > b.first; });
   for (std::size_t k = 0; k < m; ++k) cloud->points[keys[k].second].intensity = 0.0f;
+}
+
+std::size_t scaleObjectIntensity(DetectorSample* s, const Box& box, double gain, double dt) {
+  const GtDatabaseOptions grow;
+  auto scale = [gain](Point* p) { p->intensity = static_cast<float>(std::clamp(p->intensity * gain, 0.0, 1.0)); };
+  std::size_t changed = 0;
+  const GtRegion now(box, grow);
+  for (Point& p : s->current.points)
+    if (now.contains(p)) scale(&p), ++changed;
+  if (s->has_previous) {
+    Box then = box;
+    then.x -= box.vx * dt;
+    then.y -= box.vy * dt;
+    const GtRegion before(transformBox(then, s->prev_to_current.inverse()), grow);
+    for (Point& p : s->previous.points)
+      if (before.contains(p)) scale(&p);
+  }
+  return changed;
 }
 
 void dropPreviousSweep(DetectorSample* s) {

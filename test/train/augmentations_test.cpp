@@ -6,6 +6,7 @@
 #include <cstring>
 #include <fstream>
 #include <set>
+#include <tuple>
 
 #include <gtest/gtest.h>
 
@@ -207,6 +208,49 @@ TEST(SensorAugment, IntensityZeroingHitsTheFractionAndIntensitiesStayInRange) {
   o.intensity_constant_value = 0.25;
   SensorAugmenter(o).apply(&s, &rng);
   for (const Point& p : s.current.points) ASSERT_EQ(p.intensity, 0.25f);
+}
+
+// Per-object intensity gain: the returns of the object (in both sweeps, where it was then) change, nothing else.
+TEST(SensorAugment, ObjectIntensityGainScalesThatObjectsReturnsOnly) {
+  const DetectorSample orig = makeSample(someBoxes());
+  DetectorSample s = orig;
+  const Box& ped = orig.boxes[2];
+  const std::size_t changed = scaleObjectIntensity(&s, ped, 0.5, 0.1);
+  EXPECT_GT(changed, 20u);
+  const GtRegion region(ped, GtDatabaseOptions());
+  for (const auto& [now, was, T] :
+       {std::tuple{&s.current, &orig.current, Eigen::Isometry3d::Identity()},
+        std::tuple{&s.previous, &orig.previous, orig.prev_to_current}}) {
+    ASSERT_EQ(now->size(), was->size());
+    std::size_t inside = 0;
+    for (std::size_t i = 0; i < now->size(); ++i) {
+      const Point& p = was->points[i];
+      const Eigen::Vector3d w = T * Eigen::Vector3d(p.x, p.y, p.z);  // where it is in the current frame
+      const bool in = region.contains({static_cast<float>(w.x()), static_cast<float>(w.y()),
+                                       static_cast<float>(w.z()), p.intensity});
+      inside += in;
+      EXPECT_FLOAT_EQ(now->points[i].intensity, in ? 0.5f * p.intensity : p.intensity) << i;
+    }
+    EXPECT_EQ(inside, changed);  // the object stood still: as many returns in the previous sweep
+  }
+
+  // Through apply(): every object gets a gain in the range, clamped to 1; the ground keeps its intensities.
+  SensorAugmentOptions o;
+  o.object_intensity_probability = 1.0;
+  o.object_intensity_gain_min = o.object_intensity_gain_max = 4.0;
+  s = orig;
+  std::mt19937 rng(5);
+  SensorAugmenter(o).apply(&s, &rng);
+  std::size_t brightened = 0, same = 0;
+  for (std::size_t i = 0; i < s.current.size(); ++i) {
+    const float a = orig.current.points[i].intensity, b = s.current.points[i].intensity;
+    ASSERT_LE(b, 1.0f);
+    if (b == a) ++same;
+    else if (b == std::min(1.0f, 4.0f * a)) ++brightened;
+    else ADD_FAILURE() << "point " << i << ": " << a << " -> " << b;
+  }
+  EXPECT_GT(brightened, 100u);
+  EXPECT_GT(same, 20000u);
 }
 
 TEST(SensorAugment, PreviousSweepDropoutClearsItAndInvalidatesVelocities) {

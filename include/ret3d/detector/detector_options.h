@@ -169,6 +169,12 @@ struct SensorAugmentOptions {
   // (real HDL-64E scans have 10-16 % such returns, the simulator < 1 %), far points preferred (weight ~ range).
   double intensity_zero_probability = 0.0;
   double intensity_zero_max = 0.2;
+  // Per object: with this probability each labelled object's returns (both sweeps) have their intensity multiplied
+  // by a gain drawn log-uniformly in [object_intensity_gain_min, object_intensity_gain_max] (clamped to 1). The
+  // simulator draws one reflectivity per surface of an actor; real clothing and paint at 905 nm range from dark to
+  // bright, so no class should be known by how bright its returns are.
+  double object_intensity_probability = 0.0;
+  double object_intensity_gain_min = 0.5, object_intensity_gain_max = 2.0;
   // Intensity-free: with this probability every intensity becomes intensity_constant_value.
   double intensity_constant_probability = 0.0;
   double intensity_constant_value = 0.25;

@@ -75,6 +75,10 @@ void dropRays(PointCloud* cloud, double p, double far, std::mt19937* rng);
 // Sets exactly round(fraction * size) intensities to 0, drawn with weight proportional to range (far returns are
 // the weak ones).
 void zeroIntensities(PointCloud* cloud, double fraction, std::mt19937* rng);
+// Multiplies the intensity of the returns inside `box` (the ground-truth cut region: the box grown a little) by
+// `gain`, clamped to [0, 1]; in the previous sweep where the object was then (the box moved back by its velocity over
+// `dt` seconds, into the previous sweep's frame). Returns the current sweep's points changed.
+std::size_t scaleObjectIntensity(DetectorSample* s, const Box& box, double gain, double dt);
 // Removes the previous sweep; the velocities can no longer be seen, so they become invalid.
 void dropPreviousSweep(DetectorSample* s);
 // Moves the sensor: up by dz, then pitch and roll (rad) about its origin; points and boxes alike, yaw kept.
