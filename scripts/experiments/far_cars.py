@@ -14,6 +14,19 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 from fit_score_calibration import load_boxes, load_calib  # noqa: E402
 
 
+def returns_in_label(pts, Tinv, box):
+    """The returns (N x 3, sensor frame) inside a camera-frame label box (x, y, z, h, w, l, ry, ...) grown by 0.1 m
+    on every side, and the box centre in the sensor frame."""
+    x, y, z, h, w, l, ry = box[:7]
+    c = Tinv @ np.array([x, y - h / 2, z, 1.0])
+    yaw = -ry - math.pi / 2
+    d = pts[:, :2] - c[:2]
+    u = d[:, 0] * math.cos(yaw) + d[:, 1] * math.sin(yaw)
+    v = -d[:, 0] * math.sin(yaw) + d[:, 1] * math.cos(yaw)
+    inside = (np.abs(u) <= l / 2 + 0.1) & (np.abs(v) <= w / 2 + 0.1) & (np.abs(pts[:, 2] - c[2]) <= h / 2 + 0.1)
+    return int(inside.sum()), c
+
+
 def main():
     root = sys.argv[1].rstrip("/")
     root = root if root.endswith("training") else root + "/training"
@@ -28,16 +41,12 @@ def main():
         pr = [load_boxes("%s/%s.txt" % (p, s), "Car", False) for p, _ in preds]
         for frame, boxes in sorted(gt.items()):
             pts = np.fromfile("%s/velodyne/%s/%06d.bin" % (root, s, frame), dtype=np.float32).reshape(-1, 4)[:, :3]
-            for (x, y, z, h, w, l, ry, _) in boxes:
-                c = Tinv @ np.array([x, y - h / 2, z, 1.0])  # box centre in the sensor frame
-                yaw = -ry - math.pi / 2
-                d = pts[:, :2] - c[:2]
-                u = d[:, 0] * math.cos(yaw) + d[:, 1] * math.sin(yaw)
-                v = -d[:, 0] * math.sin(yaw) + d[:, 1] * math.cos(yaw)
-                inside = (np.abs(u) <= l / 2 + 0.1) & (np.abs(v) <= w / 2 + 0.1) & (np.abs(pts[:, 2] - c[2]) <= h / 2 + 0.1)
+            for box in boxes:
+                x, _, z = box[:3]
+                n, c = returns_in_label(pts, Tinv, box)
                 found = [any(math.hypot(px - x, pz - z) < 2.0 for (px, _, pz, *_) in p.get(frame, []))
                          for p in pr]
-                rows.append((math.hypot(c[0], c[1]), int(inside.sum()), found))
+                rows.append((math.hypot(c[0], c[1]), n, found))
     names = [n for _, n in preds]
     print("| range (m) | car labels | with >= 5 / >= 20 returns | " + " | ".join("found by %s" % n for n in names) + " |")
     print("| --- | --- | --- | " + " | ".join("---" for _ in names) + " |")

@@ -4,26 +4,15 @@ the labels' 80 m). Writes, for each minimum return count K, a KITTI tracking res
 labels whose box (grown by 0.1 m) holds at least K LiDAR returns, with their true track ids and score 1: a perfect
 detector and tracker for those cars, and blind to the others. `ret3d eval --metric mot` on each gives the bound.
   scripts/experiments/oracle_tracks.py GT_ROOT OUT_DIR K [K...]   (writes OUT_DIR/min<K>/SSSS.txt)"""
-import math
 import os
 import sys
 
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from far_cars import returns_in_label  # noqa: E402
 from fit_score_calibration import load_calib  # noqa: E402
-
-
-def returns_in(pts, Tinv, f):
-    """LiDAR returns inside a KITTI label's box (fields as strings: h w l x y z ry at 10-16), grown by 0.1 m."""
-    h, w, l, x, y, z, ry = (float(v) for v in f[10:17])
-    c = Tinv @ np.array([x, y - h / 2, z, 1.0])  # box centre in the sensor frame
-    yaw = -ry - math.pi / 2
-    d = pts[:, :2] - c[:2]
-    u = d[:, 0] * math.cos(yaw) + d[:, 1] * math.sin(yaw)
-    v = -d[:, 0] * math.sin(yaw) + d[:, 1] * math.cos(yaw)
-    inside = (np.abs(u) <= l / 2 + 0.1) & (np.abs(v) <= w / 2 + 0.1) & (np.abs(pts[:, 2] - c[2]) <= h / 2 + 0.1)
-    return int(inside.sum())
 
 
 def main():
@@ -44,7 +33,8 @@ def main():
         for frame, rows in sorted(by_frame.items()):
             pts = np.fromfile("%s/velodyne/%s/%06d.bin" % (root, s, frame), dtype=np.float32).reshape(-1, 4)[:, :3]
             for f in rows:
-                n = returns_in(pts, Tinv, f)
+                h, w, l, x, y, z, ry = (float(v) for v in f[10:17])
+                n = returns_in_label(pts, Tinv, (x, y, z, h, w, l, ry))[0]
                 labels += 1
                 for k in ks:
                     if n >= k:

@@ -190,8 +190,7 @@ void SensorAugmenter::apply(DetectorSample* s, std::mt19937* rng) const {
 
   if (o_.object_intensity_probability > 0) {
     const double lo = std::log(o_.object_intensity_gain_min), hi = std::log(o_.object_intensity_gain_max);
-    const std::vector<Box> objects = s->boxes;  // pasted ones too
-    for (const Box& b : objects)
+    for (const Box& b : s->boxes)  // pasted ones too (scaling changes points, never boxes)
       if (chance(o_.object_intensity_probability))
         scaleObjectIntensity(s, b, std::exp(lo + (hi - lo) * U(*rng)), kSweepDt);
   }

@@ -88,9 +88,10 @@ struct GridExtent {
 // The two-resolution detector (issue 20): a second model, trained on coarser cells over more ground (e.g. x +-80,
 // y +-48 m in 0.5 m cells, config/detector/lwd3d_anchor_far.yaml), runs beside this one. This model's network keeps
 // its fine cells over the near field (its grid, or inference.grid_extent); a box whose centre lies inside the near
-// field shrunk by `margin` on every side comes from it, any other box from the far model's. Their candidates meet in
-// one NMS, and each box is refined and scored by the options of the model it came from (the far model's score
-// calibration is its own, from its file). So far cars cost the coarse cells' time, and near ones keep the fine cells.
+// field shrunk by `margin` on every side comes from it, any other box from the far model's. Each model's candidates
+// go through NMS and voting on their own (a far box overlapping a near one of its class is then dropped), and each box
+// is refined and scored by the options of the model it came from (the far model's score calibration is its own, from
+// its file). So far cars cost the coarse cells' time, and near ones keep the fine cells.
 struct FarFieldOptions {
   std::string model_path;  // a detector model file; a relative path is relative to the near model file's folder
   double margin = 2.0;     // m: near-field boxes this close to its edge (cut off there, seen without context) yield
