@@ -33,6 +33,9 @@ struct Detector::Impl {
   decltype(PointRefineOptions::score_calibration) far_calibration;
   std::unique_ptr<BevEncoder> far_encoder;
   BevImage far_bev;
+  // The ego box (inference.ego_box): the sensor's pose in base_link, and the sweeps with the vehicle's returns removed.
+  Eigen::Isometry3d sensor_to_base = defaultSensorToBase();
+  PointCloud current_outside, previous_outside;
 
   void loadFarField(const DetectorOptions& options);
   void setFarInference(const InferenceOptions& near);
@@ -123,9 +126,20 @@ std::string Detector::describeGrids() const {
 }
 nn::DetectorModel& Detector::model() { return *impl_->model; }
 
-Detections Detector::detect(const PointCloud& current, const PointCloud* previous,
+Detections Detector::detect(const PointCloud& current_in, const PointCloud* previous_in,
                             const Eigen::Isometry3d& prev_to_current) {
   Impl& im = *impl_;
+  const std::optional<EgoBox>& ego = options_.inference.ego_box;
+  if (ego) {  // the vehicle's own returns out of both sweeps (the previous one in its own sensor frame)
+    im.current_outside = current_in;
+    removePointsInside(*ego, im.sensor_to_base, &im.current_outside);
+    if (previous_in) {
+      im.previous_outside = *previous_in;
+      removePointsInside(*ego, im.sensor_to_base, &im.previous_outside);
+    }
+  }
+  const PointCloud& current = ego ? im.current_outside : current_in;
+  const PointCloud* previous = ego && previous_in ? &im.previous_outside : previous_in;
   const bool far = im.far_model != nullptr;
   auto t0 = std::chrono::steady_clock::now();
   if (far)
@@ -204,7 +218,10 @@ Detections Detector::detect(const PointCloud& current, const PointCloud* previou
   }
   // Calibrated classes were let in below score_threshold (candidate_threshold): their final scores decide.
   const float min_score = o.score_threshold;
-  auto low = [&](const Box& b) { return b.score < min_score; };
+  // Nothing stands inside or against the vehicle's own body.
+  auto low = [&](const Box& b) {
+    return b.score < min_score || (ego && ego->touches(b, im.sensor_to_base, InferenceOptions::kEgoMargin));
+  };
   det.boxes.erase(std::remove_if(det.boxes.begin(), det.boxes.end(), low), det.boxes.end());
   far_boxes.erase(std::remove_if(far_boxes.begin(), far_boxes.end(), low), far_boxes.end());
   timings_.refine_ms = msSince(t0);
@@ -234,6 +251,9 @@ Detections Detector::detect(const PointCloud& current, const PointCloud* previou
   if (was_training) model.net->train();
   return det;
 }
+
+void Detector::setSensorToBase(const Eigen::Isometry3d& sensor_to_base) { impl_->sensor_to_base = sensor_to_base; }
+const Eigen::Isometry3d& Detector::sensorToBase() const { return impl_->sensor_to_base; }
 
 void Detector::setThresholds(double score_threshold, double nms_iou) {
   InferenceOptions next = options_.inference;

@@ -101,6 +101,7 @@ void InferenceOptions::validate() const {
   for (const auto& [c, speed] : heading_from_velocity)
     checkOption(std::string("heading_from_velocity.") + className(c), speed, kHeadingSpeed);
   if (grid_extent) GridExtent::fromValues(grid_extent->values());
+  if (ego_box) EgoBox::fromValues(ego_box->values());
   if (far_field) {
     if (far_field->model_path.empty()) throw OptionError("far_field.model_path", "", "must name a model file");
     checkOption("far_field.margin", far_field->margin, FarFieldOptions::kMargin);
@@ -260,6 +261,14 @@ void readInference(YamlReader r, InferenceOptions* o) {
       r.fail(e.key(), e.reason() + ", got " + e.value());
     }
   }
+  std::vector<double> ego;
+  if (r.get("ego_box", &ego)) {
+    try {
+      o->ego_box = ego.empty() ? std::nullopt : std::optional<EgoBox>(EgoBox::fromValues(ego));
+    } catch (const OptionError& e) {
+      r.fail(e.key(), e.reason() + ", got " + e.value());
+    }
+  }
   if (r.has("far_field")) {
     YamlReader f = r.child("far_field");
     FarFieldOptions far;
@@ -289,6 +298,10 @@ void readInference(YamlReader r, InferenceOptions* o) {
     p.get("heading_step_deg", &o->point_refine.heading_step_deg);
     p.get("heading_min_points", &o->point_refine.heading_min_points);
     readClassValues(p, "score_calibration", &o->point_refine.score_calibration);
+    p.getClasses("clear_above", &o->point_refine.clear_above);
+    p.get("clear_above_gap", &o->point_refine.clear_above_gap);
+    p.get("clear_above_height", &o->point_refine.clear_above_height);
+    p.get("clear_above_max_returns", &o->point_refine.clear_above_max_returns);
     p.finish();
   }
   r.finish();

@@ -34,6 +34,12 @@ void PointRefineOptions::validate() const {
   if (heading_any && !(heading_search_deg > 0)) fail("heading_any", "needs heading_search_deg > 0");
   if (!(heading_step_deg > 0 && heading_step_deg <= 10)) fail("heading_step_deg", "must lie in (0, 10] deg");
   if (heading_min_points < 3) fail("heading_min_points", "must be >= 3");
+  if (!(clear_above_gap >= 0 && clear_above_gap < 5)) fail("clear_above_gap", "must lie in [0, 5) m");
+  if (!(clear_above_height > clear_above_gap && clear_above_height < 10))
+    fail("clear_above_height", "must lie in (clear_above_gap, 10) m");
+  if (clear_above_max_returns < 0) fail("clear_above_max_returns", "must be >= 0");
+  for (ObjectClass c : clear_above)
+    if (c == ObjectClass::Unknown) fail("clear_above", "must name Car, Pedestrian or Cyclist");
   for (const auto& [c, w] : score_calibration) {
     if (c == ObjectClass::Unknown) fail("score_calibration", "must name Car, Pedestrian or Cyclist");
     if (w.size() != kCalibrationFeatures)
@@ -272,6 +278,10 @@ bool refineCentroid(const PointCloud& cloud, const CellIndex& index, const Point
   return moved;
 }
 
+bool needsClearAbove(const PointRefineOptions& o, const Box& b) {
+  return std::find(o.clear_above.begin(), o.clear_above.end(), b.label) != o.clear_above.end();
+}
+
 // The calibrated score of box `b` from its returns `r` (score_calibration in the header).
 double calibratedScore(const std::vector<double>& w, const Box& b, BoxReturns* r) {
   const std::size_t n = r->u.size();
@@ -301,7 +311,8 @@ std::size_t refineBoxesFromPoints(const PointCloud& cloud, std::vector<Box>* box
       if (c == b.label) return &w;
     return nullptr;
   };
-  // The face classes' mode (1), the centroid offset (2) of a box, or only its score calibrated (3); 0 = none.
+  // The face classes' mode (1), the centroid offset (2) of a box, or only its score calibrated or the space above it
+  // checked (3); 0 = none.
   auto mode = [&](const Box& b, double* offset) {
     if (!(b.length > 0 && b.width > 0 && b.height > 0 && std::isfinite(b.x) && std::isfinite(b.y) &&
           std::isfinite(b.z) && std::isfinite(b.yaw)))
@@ -309,7 +320,7 @@ std::size_t refineBoxesFromPoints(const PointCloud& cloud, std::vector<Box>* box
     if (std::find(o.faces.begin(), o.faces.end(), b.label) != o.faces.end()) return 1;
     for (const auto& [c, off] : o.centroid)
       if (c == b.label) return *offset = off, 2;
-    return calibration(b) ? 3 : 0;
+    return calibration(b) || needsClearAbove(o, b) ? 3 : 0;
   };
   double x0 = 1e300, y0 = 1e300, z0 = 1e300, x1 = -1e300, y1 = -1e300, z1 = -1e300, offset = 0;
   for (const Box& b : *boxes) {
@@ -318,6 +329,7 @@ std::size_t refineBoxesFromPoints(const PointCloud& cloud, std::vector<Box>* box
     const double r = 0.5 * std::hypot(b.length, b.width) + margin + o.max_shift;
     x0 = std::min(x0, b.x - r), y0 = std::min(y0, b.y - r), z0 = std::min(z0, b.bottom() + o.ground_clearance);
     x1 = std::max(x1, b.x + r), y1 = std::max(y1, b.y + r), z1 = std::max(z1, b.top() + 2 * margin);
+    if (needsClearAbove(o, b)) z1 = std::max(z1, b.top() + o.max_shift + o.clear_above_height);
   }
   if (x0 > x1 || cloud.empty()) return 0;
   const CellIndex index(cloud, x0, y0, x1 + 1e-6, y1 + 1e-6, z0, z1, 1.0);
@@ -333,6 +345,13 @@ std::size_t refineBoxesFromPoints(const PointCloud& cloud, std::vector<Box>* box
       b.score = static_cast<float>(calibratedScore(*w, b, &returns));
     }
   }
+  const auto covered = std::remove_if(boxes->begin(), boxes->end(), [&](const Box& b) {
+    if (!needsClearAbove(o, b) || mode(b, &offset) == 0) return false;
+    returns.collect(cloud, index, b, 0.0, b.height + o.clear_above_gap, b.top() + o.clear_above_height);
+    return static_cast<int>(returns.u.size()) > o.clear_above_max_returns;
+  });
+  changed += static_cast<std::size_t>(boxes->end() - covered);
+  boxes->erase(covered, boxes->end());
   return changed;
 }
 

@@ -6,7 +6,8 @@
 // (nonfinite_points), more points than ~max_points (over_point_limit: thinned evenly, not dropped), an empty
 // (empty) or malformed (malformed) cloud (empty detections published), a missing transform (no_transform: previous
 // sweep used without motion compensation), stamps going backwards (stamp_backwards), a gap longer than
-// ~max_sweep_gap (sweep_gap) or a changed frame id (frame_changed): previous sweep not used.
+// ~max_sweep_gap (sweep_gap) or a changed frame id (frame_changed): previous sweep not used; no transform from the
+// sensor to ~base_frame (no_base_transform: the ego box placed with KITTI's mount).
 #include <chrono>
 #include <cmath>
 #include <mutex>
@@ -146,6 +147,7 @@ class DetectorNodelet : public StageNodelet<sensor_msgs::PointCloud2> {
     Detections detections;
     {
       std::lock_guard<std::mutex> lock(detector_mutex_);  // thresholds may change from the reconfigure thread
+      placeEgoBox(msg->header.frame_id);
       detections = detector_->detect(cloud, previous, prev_to_current);
     }
     publisher_.publish(toDetectionArrayMsg(detections, msg->header));
@@ -156,6 +158,23 @@ class DetectorNodelet : public StageNodelet<sensor_msgs::PointCloud2> {
     previous_->frame_id = msg->header.frame_id;
     previous_->sensor_to_fixed = pose.sensor_to_fixed;
     previous_->pose_found = pose.found;
+  }
+
+  // The ego box lies in ~base_frame: the sensor's mount in it from tf, once per sensor frame (a static transform);
+  // until tf has it, KITTI's mount (defaultSensorToBase), said and counted.
+  void placeEgoBox(const std::string& sensor_frame) {
+    if (!detector_->options().inference.ego_box || mounted_frame_ == sensor_frame) return;
+    std::string problem;
+    if (const auto mount = poses_->latest(params_.base_frame, sensor_frame, &problem)) {
+      detector_->setSensorToBase(*mount);
+      mounted_frame_ = sensor_frame;
+      NODELET_INFO_STREAM("ego box " << detector_->options().inference.ego_box->describe() << " in "
+                                     << params_.base_frame << ", sensor frame " << sensor_frame << " from tf");
+      return;
+    }
+    detector_->setSensorToBase(defaultSensorToBase());
+    degraded("no_base_transform", "no transform " + sensor_frame + " -> " + params_.base_frame + " (" + problem +
+                                      "): the ego box placed with the sensor 1.73 m above " + params_.base_frame);
   }
 
   struct Sweep {
@@ -171,6 +190,7 @@ class DetectorNodelet : public StageNodelet<sensor_msgs::PointCloud2> {
   std::unique_ptr<PoseSource> poses_;
   ros::Publisher publisher_;
   std::optional<Sweep> previous_;
+  std::string mounted_frame_;  // the sensor frame whose mount in ~base_frame the detector holds
   std::mutex detector_mutex_;
   boost::recursive_mutex reconfigure_mutex_;
   std::unique_ptr<dynamic_reconfigure::Server<ret3d::DetectorConfig>> reconfigure_;

@@ -205,12 +205,17 @@ DetectorNodeletParams loadDetectorNodeletParams(const ros::NodeHandle& private_n
   // The ground the network covers (a trained model runs on a wider grid at a cost in proportion to its area).
   try {
     if (p.has("grid_extent")) inf.grid_extent = GridExtent::fromValues(p.numbers("grid_extent", {}));
+    if (p.has("ego_box")) {
+      const std::vector<double> ego = p.numbers("ego_box", {});
+      inf.ego_box = ego.empty() ? std::nullopt : std::optional<EgoBox>(EgoBox::fromValues(ego));
+    }
     params.detector.validate();
   } catch (const OptionError& e) {
     // The parameters above were read in validate()'s ranges and the model's own options checked when it was read:
-    // what is left to refuse is the grid extent.
-    if (e.key() == "grid_extent" || e.key() == "inference.grid_extent")
-      throw ParamError("parameter " + p.fullName("grid_extent") + " = " + e.value() + ": " + e.reason());
+    // what is left to refuse is the grid extent or the ego box.
+    for (const std::string key : {"grid_extent", "ego_box"})
+      if (e.key() == key || e.key() == "inference." + key)
+        throw ParamError("parameter " + p.fullName(key) + " = " + e.value() + ": " + e.reason());
     const std::string name = config.empty() ? "model_path" : "config";
     throw ParamError("parameter " + p.fullName(name) + " = '" + (config.empty() ? model_path : config) +
                      "': " + e.what());
@@ -227,6 +232,7 @@ DetectorNodeletParams loadDetectorNodeletParams(const ros::NodeHandle& private_n
   params.cloud.max_points = static_cast<std::size_t>(p.integer("max_points", 500000, 1000, 10000000));
   params.pose = loadPoseParams(p);
   params.max_sweep_gap = p.number("max_sweep_gap", params.max_sweep_gap, 0.0, 10.0);
+  params.base_frame = p.nonEmpty("base_frame", params.base_frame);
   return params;
 }
 

@@ -157,8 +157,13 @@ std::vector<std::size_t> GreedyTracker::step(const std::vector<Box>& detections,
       track->position = centre;
       track->last_seen = stamp;
       track->misses = 0;
+      if (!track->confirmed) {
+        ++track->hits;
+        track->confirmed = c.fixed.score >= options_.confirm_score.at(label) || track->hits >= options_.min_hits.at(label);
+      }
       fixed.track_id = track->id;
       track->history.push(fixed, stamp, features ? features + c.index * feature_dim : nullptr, feature_dim);
+      if (!track->confirmed) continue;
 
       Box out = detections[c.index];
       out.track_id = track->id;
@@ -172,12 +177,13 @@ std::vector<std::size_t> GreedyTracker::step(const std::vector<Box>& detections,
     }
   }
 
-  // Unmatched tracks coast on their velocity (not output); those unmatched for more than max_age frames end.
+  // Unmatched tracks coast on their velocity (not output); those unmatched for more than max_age frames end, and
+  // tentative ones at their first miss.
   std::size_t kept = 0;
   for (std::size_t t = 0; t < tracks_.size(); ++t) {
     Track& tr = tracks_[t];
     if (!track_matched[t]) {
-      if (++tr.misses > options_.max_age) continue;
+      if (++tr.misses > options_.max_age || !tr.confirmed) continue;
       if (tr.velocity_known) tr.position.head<2>() += tr.velocity * dt;
     }
     if (kept != t) tracks_[kept] = std::move(tr);

@@ -19,6 +19,17 @@ std::string str(double v) {
   return os.str();
 }
 
+// A per-class option given as one number for every class or as a map by class.
+template <typename T>
+void getOneOrPerClass(YamlReader& r, const std::string& key, PerClass<T>* value) {
+  T one_for_all{};
+  if (r.isMap(key)) {
+    r.getPerClass(key, value);
+  } else if (r.get(key, &one_for_all)) {
+    *value = {one_for_all, one_for_all, one_for_all};
+  }
+}
+
 // Value errors are std::invalid_argument, as validate() throws them; a file that cannot be read or parsed is a
 // std::runtime_error (a ConfigError).
 TrackerOptions readTrackerOptions(YamlReader r) {
@@ -29,12 +40,9 @@ TrackerOptions readTrackerOptions(YamlReader r) {
     r.getPerClass("gate", &o.gate);
     r.getPerClass("max_speed", &o.max_speed);
     r.get("score_threshold", &o.score_threshold);
-    double one_for_all = 0;
-    if (r.isMap("birth_score")) {
-      r.getPerClass("birth_score", &o.birth_score);
-    } else if (r.get("birth_score", &one_for_all)) {
-      o.birth_score = {one_for_all, one_for_all, one_for_all};
-    }
+    getOneOrPerClass(r, "birth_score", &o.birth_score);
+    getOneOrPerClass(r, "confirm_score", &o.confirm_score);
+    getOneOrPerClass(r, "min_hits", &o.min_hits);
     r.get("max_age", &o.max_age);
     r.get("max_time_gap", &o.max_time_gap);
     r.get("use_detection_velocity", &o.use_detection_velocity);
@@ -65,6 +73,10 @@ void validate(const TrackerOptions& o) {
     if (!std::isfinite(s) || s < 0.0) invalid("max_speed." + cls, str(s), "a finite speed >= 0 (m/s)");
     const double b = o.birth_score.at(c);
     if (!std::isfinite(b)) invalid("birth_score." + cls, str(b), "a finite number");
+    const double cs = o.confirm_score.at(c);
+    if (!std::isfinite(cs)) invalid("confirm_score." + cls, str(cs), "a finite number");
+    const int h = o.min_hits.at(c);
+    if (h < 1 || h > 1000) invalid("min_hits." + cls, str(h), "an integer in [1, 1000] (frames)");
   }
   if (!std::isfinite(o.score_threshold)) invalid("score_threshold", str(o.score_threshold), "a finite number");
   if (o.max_age < 0 || o.max_age > 1000) invalid("max_age", str(o.max_age), "an integer in [0, 1000] (frames)");

@@ -47,6 +47,38 @@ TEST(Detector, ReturnsBoxesWithOneFeatureRowEachAndTimesItsParts) {
   EXPECT_TRUE(empty.features.empty());
 }
 
+// The ego box: the vehicle's own returns never reach the network, and no box is published inside or against its body,
+// wherever the sensor sits on it.
+TEST(Detector, NothingIsPublishedInsideOrAgainstTheEgoVehicle) {
+  DetectorOptions o;
+  o.model.geometry.x_min = -16, o.model.geometry.x_max = 16, o.model.geometry.y_min = -16, o.model.geometry.y_max = 16;
+  o.inference.score_threshold = 0.0f;  // untrained: every peak passes, all over the grid
+  o.inference.max_candidates = 100000;
+  o.inference.max_detections = 100000;
+  PointCloud cloud;  // returns all around, the ego's body included
+  for (int i = 0; i < 4000; ++i)
+    cloud.push_back({-10.0f + static_cast<float>(i % 80) * 0.25f, -10.0f + static_cast<float>(i / 80) * 0.4f,
+                     -1.2f + 0.01f * static_cast<float>(i % 50), 0.5f});
+  const EgoBox ego;  // KITTI's car
+  for (const Eigen::Isometry3d& mount :
+       {defaultSensorToBase(), Eigen::Isometry3d(Eigen::Translation3d(1.2, 0.3, 1.9) *
+                                                 Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ()))}) {
+    Detector d(o);
+    d.setSensorToBase(mount);
+    const Detections det = d.detect(cloud, &cloud);
+    ASSERT_GT(det.boxes.size(), 50u);
+    for (const Box& b : det.boxes)
+      EXPECT_FALSE(ego.touches(b, mount, InferenceOptions::kEgoMargin)) << "box at " << b.x << ", " << b.y;
+    // Switched off, boxes do come out there.
+    DetectorOptions off = o;
+    off.inference.ego_box.reset();
+    Detector all(off);
+    const Detections every = all.detect(cloud, &cloud);
+    EXPECT_TRUE(std::any_of(every.boxes.begin(), every.boxes.end(),
+                            [&](const Box& b) { return ego.touches(b, mount, InferenceOptions::kEgoMargin); }));
+  }
+}
+
 // A calibrated class's candidates are let in from candidate_threshold, and published only when their calibrated
 // score reaches score_threshold: a box the network scores low but many returns hold comes out, the rest do not.
 TEST(Detector, CalibratedClassesArePublishedOnTheirCalibratedScore) {

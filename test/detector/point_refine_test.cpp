@@ -304,6 +304,44 @@ TEST(PointRefine, PutsASmallObjectBehindTheCentroidOfItsReturns) {
   EXPECT_DOUBLE_EQ(boxes[0].yaw, guess.yaw);
 }
 
+// A pole or a trunk runs on above the height of a person; nothing stands right above a person's head. A pedestrian box
+// on a pole is removed, one on a person is kept, and so is one under a tree's crown or a bridge high above.
+TEST(PointRefine, APedestrianBoxWithReturnsRightAboveItsTopIsRemoved) {
+  // Sensor frame (ground at -1.73 m). A column of returns: a person (to 1.75 m) or a pole (to 4 m).
+  auto column = [](double cx, double cy, double radius, double top, PointCloud* cloud) {
+    for (double z = -1.5; z < top - 1.73; z += 0.1)
+      for (double a = -1.0; a <= 1.0; a += 0.25)
+        cloud->push_back({static_cast<float>(cx - radius * std::cos(std::atan2(cy, cx) + a)),
+                          static_cast<float>(cy - radius * std::sin(std::atan2(cy, cx) + a)), static_cast<float>(z),
+                          0.3f});
+  };
+  PointCloud cloud;
+  column(12, 3, 0.2, 1.75, &cloud);   // a person
+  column(15, -4, 0.12, 4.0, &cloud);  // a sign pole
+  column(20, 6, 0.2, 1.75, &cloud);   // a person under a crown 3.2-5 m above the ground
+  for (double x = 18.5; x < 21.5; x += 0.2)
+    for (double y = 4.5; y < 7.5; y += 0.2) cloud.push_back({static_cast<float>(x), static_cast<float>(y), 1.6f, 0.2f});
+  auto pedestrian = [](double x, double y) {
+    Box b = carBox(x, y, 0.0, 0.7, 0.7, 1.75);
+    b.label = ObjectClass::Pedestrian;
+    b.z = -1.73 + 0.5 * 1.75;
+    b.score = 0.8f;
+    return b;
+  };
+  std::vector<Box> boxes = {pedestrian(12, 3), pedestrian(15, -4), pedestrian(20, 6)};
+  PointRefineOptions o;
+  o.clear_above = {ObjectClass::Pedestrian};
+  EXPECT_EQ(refineBoxesFromPoints(cloud, &boxes, o), 1u);
+  ASSERT_EQ(boxes.size(), 2u);
+  EXPECT_DOUBLE_EQ(boxes[0].x, 12);
+  EXPECT_DOUBLE_EQ(boxes[1].x, 20);
+  // Other classes are not checked: a car box on the pole stays.
+  std::vector<Box> car = {carBox(15, -4, 0.0)};
+  car[0].z = -1.73 + 0.75;
+  EXPECT_EQ(refineBoxesFromPoints(cloud, &car, o), 0u);
+  EXPECT_EQ(car.size(), 1u);
+}
+
 TEST(HeadingFromVelocity, MovingBoxesOfTheListedClassesFaceTheirVelocity) {
   Box walker = carBox(5, 5, 0.0, 0.8, 0.6, 1.7);
   walker.label = ObjectClass::Pedestrian;

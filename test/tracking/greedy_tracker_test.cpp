@@ -353,6 +353,71 @@ TEST(GreedyTracker, BirthScoreAndScoreThreshold) {
   EXPECT_TRUE(tracker.update({a}, 0.3, Eigen::Isometry3d::Identity()).empty());
 }
 
+// The publishing rule: a track's boxes are output from its confirming frame on (min_hits consecutive matches, or one
+// detection scoring confirm_score); a false box seen in one frame alone is never output.
+TEST(GreedyTracker, OnlyConfirmedTracksArePublished) {
+  TrackerOptions o;
+  o.score_threshold = 0.05;
+  o.birth_score = {0.3, 0.3, 0.3};
+  o.confirm_score = {0.5, 0.5, 0.5};
+  o.min_hits = {3, 3, 3};
+  GreedyTracker tracker(o);
+  const Actor real{ObjectClass::Car, 10, 0, 10, 0};
+  const Actor strong{ObjectClass::Pedestrian, 20, 5, 1, 0};
+  std::vector<std::size_t> published_real;
+  std::uint32_t real_id = 0;
+  for (int f = 0; f < 10; ++f) {
+    const double t = 0.1 * f;
+    Box r = real.at(t);
+    r.score = 0.35f;  // born and continued below confirm_score: confirmed by hits
+    std::vector<Box> frame{r};
+    // A one-frame false box every other frame, each at a new place, above birth but below confirm_score.
+    if (f % 2 == 0) {
+      Box clutter = Actor{ObjectClass::Pedestrian, -15.0 + 3 * f, -8, 0, 0}.at(t);
+      clutter.score = 0.45f;
+      frame.push_back(clutter);
+    }
+    if (f == 4) {  // confirmed at once by its score
+      Box s = strong.at(t);
+      s.score = 0.8f;
+      frame.push_back(s);
+    }
+    const std::vector<Box> out = tracker.update(frame, t, Eigen::Isometry3d::Identity());
+    for (const Box& b : out) {
+      if (b.label == ObjectClass::Car) {
+        published_real.push_back(static_cast<std::size_t>(f));
+        if (real_id == 0) real_id = b.track_id;
+        EXPECT_EQ(b.track_id, real_id) << "frame " << f;
+      } else {
+        EXPECT_EQ(f, 4) << "a one-frame false box was published in frame " << f;
+        EXPECT_FLOAT_EQ(b.score, 0.8f);
+      }
+    }
+  }
+  // Frames 0 and 1 are tentative; from the third consecutive match on, every frame.
+  EXPECT_EQ(published_real, (std::vector<std::size_t>{2, 3, 4, 5, 6, 7, 8, 9}));
+}
+
+// A tentative track ends at its first miss: two hits, a gap, and it starts again from scratch (a new id).
+TEST(GreedyTracker, ATentativeTrackEndsAtItsFirstMiss) {
+  TrackerOptions o;
+  o.birth_score = {0.3, 0.3, 0.3};
+  o.confirm_score = {0.9, 0.9, 0.9};
+  o.min_hits = {3, 3, 3};
+  GreedyTracker tracker(o);
+  const Actor a{ObjectClass::Car, 10, 0, 0, 0};
+  std::size_t published = 0;
+  for (int f = 0; f < 7; ++f) {
+    Box b = a.at(0.1 * f);
+    b.score = 0.5f;
+    std::vector<Box> frame;
+    if (f != 2) frame.push_back(b);  // missed in frame 2
+    published += tracker.update(frame, 0.1 * f, Eigen::Isometry3d::Identity()).size();
+  }
+  EXPECT_EQ(published, 2u);  // frames 5 and 6: the third and fourth hits after the gap
+  EXPECT_EQ(tracker.lastId(), 2u);
+}
+
 TEST(GreedyTracker, ClassesAreTrackedSeparatelyAndFieldsKept) {
   GreedyTracker tracker{TrackerOptions()};
   Box car = Actor{ObjectClass::Car, 10, 0, 0, 0}.at(0);

@@ -21,6 +21,8 @@ void expectSame(const TrackerOptions& a, const TrackerOptions& b) {
     EXPECT_DOUBLE_EQ(a.gate.at(c), b.gate.at(c)) << className(c);
     EXPECT_DOUBLE_EQ(a.max_speed.at(c), b.max_speed.at(c)) << className(c);
     EXPECT_DOUBLE_EQ(a.birth_score.at(c), b.birth_score.at(c)) << className(c);
+    EXPECT_DOUBLE_EQ(a.confirm_score.at(c), b.confirm_score.at(c)) << className(c);
+    EXPECT_EQ(a.min_hits.at(c), b.min_hits.at(c)) << className(c);
   }
   EXPECT_DOUBLE_EQ(a.score_threshold, b.score_threshold);
   EXPECT_EQ(a.max_age, b.max_age);
@@ -58,6 +60,8 @@ TEST(TrackerOptions, ReadsEveryKey) {
       "score_threshold: -1\n"
       "birth_score: 2.0\n"
       "max_age: 5\n"
+      "confirm_score: {Pedestrian: 0.6}\n"
+      "min_hits: 3\n"
       "max_time_gap: 0.5\n"
       "use_detection_velocity: false\n"
       "velocity_window: 3\n"
@@ -75,6 +79,9 @@ TEST(TrackerOptions, ReadsEveryKey) {
   EXPECT_DOUBLE_EQ(per_class.birth_score.pedestrian, TrackerOptions().birth_score.pedestrian);
   EXPECT_DOUBLE_EQ(per_class.birth_score.cyclist, 0.6);
   EXPECT_EQ(o.max_age, 5);
+  EXPECT_DOUBLE_EQ(o.confirm_score.pedestrian, 0.6);
+  EXPECT_DOUBLE_EQ(o.confirm_score.car, TrackerOptions().confirm_score.car);
+  for (ObjectClass c : kDetectedClasses) EXPECT_EQ(o.min_hits.at(c), 3) << className(c);
   EXPECT_DOUBLE_EQ(o.max_time_gap, 0.5);
   EXPECT_FALSE(o.use_detection_velocity);
   EXPECT_EQ(o.velocity_window, 3);
@@ -100,6 +107,9 @@ TEST(TrackerOptions, InvalidValuesNameParameterValueAndAllowed) {
       {"birth_score: .nan", "birth_score.Car", "nan", "finite"},  // one value for all classes
       {"birth_score: {Cyclist: .nan}", "birth_score.Cyclist", "nan", "finite"},
       {"birth_score: {Truck: 0.5}", "birth_score.Truck", "unknown class", "Car, Pedestrian, Cyclist"},
+      {"min_hits: 0", "min_hits.Car", "0", "[1, 1000]"},
+      {"min_hits: {Pedestrian: 2.5}", "min_hits.Pedestrian", "2.5", "an integer"},
+      {"confirm_score: {Cyclist: .nan}", "confirm_score.Cyclist", "nan", "finite"},
       {"max_age: -1", "max_age", "-1", "[0, 1000]"},
       {"max_age: 2.5", "max_age", "2.5", "an integer"},
       {"max_time_gap: 0", "max_time_gap", "0", "> 0"},

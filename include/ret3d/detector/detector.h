@@ -45,6 +45,10 @@ class Detector {
                     const Eigen::Isometry3d& prev_to_current = Eigen::Isometry3d::Identity());
 
   const DetectorOptions& options() const { return options_; }
+  // The sensor's pose in the vehicle's base_link, where inference.ego_box lies (default: defaultSensorToBase(),
+  // KITTI's mount 1.73 m above the ground); the detector nodelet sets it from tf.
+  void setSensorToBase(const Eigen::Isometry3d& sensor_to_base);
+  const Eigen::Isometry3d& sensorToBase() const;
   // Changes the inference thresholds between calls (dynamic_reconfigure); throws OptionError, changing nothing, for a
   // value InferenceOptions::validate() refuses.
   void setThresholds(double score_threshold, double nms_iou);

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "ret3d/bev/bev_encoder.h"
+#include "ret3d/core/ego_box.h"
 #include "ret3d/core/option_range.h"
 #include "ret3d/core/types.h"
 #include "ret3d/detector/point_refine.h"
@@ -129,6 +130,11 @@ struct InferenceOptions {
   std::optional<GridExtent> grid_extent;
   // A far-field model beside this one (FarFieldOptions); none = this model alone.
   std::optional<FarFieldOptions> far_field;
+  // The ego vehicle's body in base_link (core/ego_box.h; default KITTI's car): its returns are dropped before the BEV
+  // image is made, and a box reaching into it grown by kEgoMargin is dropped after refinement. none (YAML `[]`) = off.
+  // The sensor's pose in base_link comes from Detector::setSensorToBase (tf online; KITTI's mount otherwise).
+  std::optional<EgoBox> ego_box = EgoBox{};
+  static constexpr double kEgoMargin = 0.3;  // m
 
   // The one allowed range of each number: YAML, the detector nodelet's parameters, cfg/Detector.cfg (a test keeps
   // its ranges equal to these) and the command line all check these.

@@ -67,16 +67,27 @@ struct PointRefineOptions {
   // on its faces, say how well it fits them. The weights are fitted on labelled data by
   // scripts/fit_score_calibration.py. Empty = scores as they are.
   std::vector<std::pair<ObjectClass, std::vector<double>>> score_calibration;
+  // Classes whose boxes need clear space right above their top (people: nothing stands on a head, where a pole, a
+  // trunk or a sign post runs on above the height of a person): a box of these classes with more than
+  // clear_above_max_returns returns inside its footprint from clear_above_gap to clear_above_height above its top is
+  // removed. Empty = off.
+  std::vector<ObjectClass> clear_above;
+  double clear_above_gap = 0.2;      // m above the box's top
+  double clear_above_height = 1.2;   // m above the box's top
+  int clear_above_max_returns = 2;
   static constexpr std::size_t kCalibrationFeatures = 9;
   static constexpr double kMaxResidual = 0.5;
 
-  bool enabled() const { return !faces.empty() || !centroid.empty() || !score_calibration.empty(); }
+  bool enabled() const {
+    return !faces.empty() || !centroid.empty() || !score_calibration.empty() || !clear_above.empty();
+  }
   // Throws std::invalid_argument naming the field when a value is out of range.
   void validate() const;
 };
 
-// Refines, in place, the boxes of the configured classes. The cloud and the boxes are in the sensor frame (the
-// sensor at the origin, z up). Other boxes are untouched. Returns the number of boxes changed.
+// Refines, in place, the boxes of the configured classes, and removes those of the clear_above classes that have
+// returns right above them. The cloud and the boxes are in the sensor frame (the sensor at the origin, z up). Other
+// boxes are untouched. Returns the number of boxes changed (refined or removed).
 std::size_t refineBoxesFromPoints(const PointCloud& cloud, std::vector<Box>* boxes, const PointRefineOptions& options);
 
 // Heading from motion: a box of a listed class moving at least at its class's speed (m/s) gets the heading of its

@@ -24,6 +24,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -78,6 +79,17 @@ class PoseSource {
     return r;
   }
   bool hasFallbackPose(const std::string& sensor_frame) const { return last_.count(sensor_frame) > 0; }
+  // The newest transform from `sensor_frame` into `target_frame` (a static mount: base_link <- sensor), without
+  // waiting; none when tf has none yet (`problem` says why).
+  std::optional<Eigen::Isometry3d> latest(const std::string& target_frame, const std::string& sensor_frame,
+                                          std::string* problem) {
+    try {
+      return tf2::transformToEigen(buffer_.lookupTransform(target_frame, sensor_frame, ros::Time(0)));
+    } catch (const tf2::TransformException& e) {
+      *problem = e.what();
+      return std::nullopt;
+    }
+  }
   const std::string& fixedFrame() const { return params_.fixed_frame; }
 
  private:

@@ -82,6 +82,9 @@ struct DetectorNodeletParams {
                                      // ~max_points (500000; a bigger cloud is thinned to this many points)
   PoseParams pose;
   double max_sweep_gap = 0.25;       // s: an older previous sweep is not used (LWD-3D's second sweep is 0.1 s back)
+  // ~ego_box ([x_min, x_max, y_min, y_max, z_min, z_max] in ~base_frame; [] = off; default the model's, KITTI's car)
+  // lies in this frame; the sensor's pose in it comes from tf (KITTI's mount while tf has none).
+  std::string base_frame = "base_link";
 };
 struct IntraRMNodeletParams {
   relation::IntraRMOptions intra;    // ~model_path, ~threads

@@ -4,7 +4,9 @@
 // Per frame and per class: each detection's centre is moved back by its velocity times the time since the last frame
 // and matched to the tracks' centres by BEV distance within a class gate, greedily in descending score (or optimally,
 // Hungarian). Matched tracks take the detection; unmatched detections scoring at least birth_score start tracks with
-// fresh ids; unmatched tracks coast on their velocity for up to max_age frames without being output.
+// fresh ids; unmatched tracks coast on their velocity for up to max_age frames without being output. A track's boxes
+// are output once it is confirmed (a detection scoring confirm_score, or min_hits consecutive matches from its birth);
+// a tentative track ends at its first miss.
 #pragma once
 
 #include <cstddef>
@@ -29,7 +31,8 @@ class GreedyTracker {
   // tracked boxes of this frame in the sensor frame, in the detections' order: each a detection as given (all its
   // fields kept) with track_id > 0 set; when the detection carried no velocity (or use_detection_velocity is off),
   // (vx, vy) are the track's estimated velocity (zero until two observations). Detections below score_threshold,
-  // of the Unknown class, or with non-finite fields are skipped; unmatched ones below birth_score are not output.
+  // of the Unknown class, or with non-finite fields are skipped; unmatched ones below birth_score are not output, nor
+  // are the boxes of tentative (not yet confirmed) tracks.
   // A stamp before the previous one (a bag loop) or more than max_time_gap after it resets the tracker first, with
   // one log line; track ids keep counting, so they are never reused within the tracker's life.
   std::vector<Box> update(const std::vector<Box>& detections, double stamp, const Eigen::Isometry3d& sensor_to_fixed);
@@ -63,6 +66,8 @@ class GreedyTracker {
     bool velocity_known = false;
     double last_seen = 0.0;  // stamp of the last match
     int misses = 0;          // consecutive frames without a match
+    int hits = 0;            // frames matched (birth included) while tentative
+    bool confirmed = false;  // its boxes are output (TrackerOptions::confirm_score, min_hits)
     TrackHistory history;
     explicit Track(std::size_t capacity) : history(capacity) {}
   };

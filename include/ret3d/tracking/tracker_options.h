@@ -36,6 +36,14 @@ struct TrackerOptions {
   // Per class (YAML: one number for all, or a map by class): a class whose scores are less calibrated (the LWD-3D
   // detector's cyclists) needs a stricter birth than the others.
   PerClass<double> birth_score{0.75, 0.75, 0.75};
+  // Publishing (AB3DMOT's min_hits; a track is "tentative" until confirmed): a track's boxes are output once it is
+  // confirmed, either by one detection scoring at least confirm_score (a box the detector itself would publish) or by
+  // being matched in min_hits consecutive frames from its birth. A tentative track is matched like any other (its
+  // history grows) but not output, and it ends at its first unmatched frame, so a box seen in one frame alone is never
+  // published unless it scores confirm_score. Per class (YAML: one number for all, or a map by class). min_hits 1:
+  // every track is confirmed at birth.
+  PerClass<double> confirm_score{0.0, 0.0, 0.0};
+  PerClass<int> min_hits{1, 1, 1};
   // Frames a track may go unmatched and still be matched again; it coasts on its velocity meanwhile and is not output.
   // CenterPoint's Waymo max_age = 3 counts the matched frame too (2 coasting frames; ours counts misses only). On the
   // PointRCNN boxes of KITTI tracking 0001-0015 car ID switches went 179 / 122 / 105 / 99 for 1 / 3 / 5 / 10: 5
