@@ -125,6 +125,8 @@ void SensorAugmentOptions::validate() const {
                                {"intensity_constant_probability", intensity_constant_probability},
                                {"intensity_constant_value", intensity_constant_value},
                                {"object_intensity_probability", object_intensity_probability},
+                               {"object_zero_probability", object_zero_probability},
+                               {"object_zero_min", object_zero_min},
                                {"previous_dropout_probability", previous_dropout_probability}})
     checkOption(key, v, unit);
   if (ray_drop_min > ray_drop_max) throw OptionError("ray_drop_min", "", "must not exceed ray_drop_max");
@@ -139,6 +141,7 @@ void SensorAugmentOptions::validate() const {
   checkOption("intensity_noise_sigma", intensity_noise_sigma, {0.0, 0.5});
   checkOption("object_intensity_gain_min", object_intensity_gain_min, {0.01, 100.0});
   checkOption("object_intensity_gain_max", object_intensity_gain_max, {object_intensity_gain_min, 100.0});
+  checkOption("object_zero_max", object_zero_max, {object_zero_min, 1.0});
   checkOption("pose_z_range", pose_z_range, {0.0, 1.0});
   checkOption("pose_tilt_deg", pose_tilt_deg, {0.0, 10.0});
   checkOption("gt_sample_margin", gt_sample_margin, {0.0, 5.0});
@@ -334,6 +337,10 @@ void readSensorAugment(YamlReader& r, SensorAugmentOptions* a) {
   r.get("object_intensity_probability", &a->object_intensity_probability);
   r.get("object_intensity_gain_min", &a->object_intensity_gain_min);
   r.get("object_intensity_gain_max", &a->object_intensity_gain_max);
+  r.get("object_zero_probability", &a->object_zero_probability);
+  r.get("object_zero_min", &a->object_zero_min);
+  r.get("object_zero_max", &a->object_zero_max);
+  r.getClasses("object_zero_classes", &a->object_zero_classes);
   r.get("previous_dropout_probability", &a->previous_dropout_probability);
   r.get("pose_z_range", &a->pose_z_range);
   r.get("pose_tilt_deg", &a->pose_tilt_deg);

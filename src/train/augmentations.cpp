@@ -194,6 +194,12 @@ void SensorAugmenter::apply(DetectorSample* s, std::mt19937* rng) const {
       if (chance(o_.object_intensity_probability))
         scaleObjectIntensity(s, b, std::exp(lo + (hi - lo) * U(*rng)), kSweepDt);
   }
+  if (o_.object_zero_probability > 0) {
+    const auto& dark = o_.object_zero_classes;
+    for (const Box& b : s->boxes)
+      if (std::find(dark.begin(), dark.end(), b.label) != dark.end() && chance(o_.object_zero_probability))
+        darkenObject(s, b, o_.object_zero_min + (o_.object_zero_max - o_.object_zero_min) * U(*rng), kSweepDt, rng);
+  }
   if (chance(o_.intensity_jitter_probability)) {
     const double scale = o_.intensity_scale_min + (o_.intensity_scale_max - o_.intensity_scale_min) * U(*rng);
     const double gamma = o_.intensity_gamma_min + (o_.intensity_gamma_max - o_.intensity_gamma_min) * U(*rng);
@@ -336,22 +342,44 @@ void zeroIntensities(PointCloud* cloud, double fraction, std::mt19937* rng) {
   for (std::size_t k = 0; k < m; ++k) cloud->points[keys[k].second].intensity = 0.0f;
 }
 
-std::size_t scaleObjectIntensity(DetectorSample* s, const Box& box, double gain, double dt) {
+namespace {
+
+// Calls f on each return of `box` in both sweeps (in the previous one where the object was then); returns the number
+// of current-sweep returns.
+template <typename F>
+std::size_t forObjectReturns(DetectorSample* s, const Box& box, double dt, F f) {
   const GtDatabaseOptions grow;
-  auto scale = [gain](Point* p) { p->intensity = static_cast<float>(std::clamp(p->intensity * gain, 0.0, 1.0)); };
-  std::size_t changed = 0;
+  std::size_t count = 0;
   const GtRegion now(box, grow);
   for (Point& p : s->current.points)
-    if (now.contains(p)) scale(&p), ++changed;
+    if (now.contains(p)) f(&p), ++count;
   if (s->has_previous) {
     Box then = box;
     then.x -= box.vx * dt;
     then.y -= box.vy * dt;
     const GtRegion before(transformBox(then, s->prev_to_current.inverse()), grow);
     for (Point& p : s->previous.points)
-      if (before.contains(p)) scale(&p);
+      if (before.contains(p)) f(&p);
   }
-  return changed;
+  return count;
+}
+
+}  // namespace
+
+std::size_t scaleObjectIntensity(DetectorSample* s, const Box& box, double gain, double dt) {
+  return forObjectReturns(s, box, dt,
+                          [gain](Point* p) { p->intensity = static_cast<float>(std::clamp(p->intensity * gain, 0.0, 1.0)); });
+}
+
+std::size_t darkenObject(DetectorSample* s, const Box& box, double fraction, double dt, std::mt19937* rng) {
+  std::bernoulli_distribution dark(std::clamp(fraction, 0.0, 1.0));
+  std::size_t zeroed = 0;
+  forObjectReturns(s, box, dt, [&](Point* p) {
+    if (!dark(*rng)) return;
+    if (p->intensity != 0.0f) ++zeroed;
+    p->intensity = 0.0f;
+  });
+  return zeroed;
 }
 
 void dropPreviousSweep(DetectorSample* s) {

@@ -253,6 +253,43 @@ TEST(SensorAugment, ObjectIntensityGainScalesThatObjectsReturnsOnly) {
   EXPECT_GT(same, 20000u);
 }
 
+// Dark objects: only the listed classes' returns turn to 0, about the drawn fraction of them; the rest is untouched.
+TEST(SensorAugment, DarkObjectsZeroAFractionOfTheirClassReturnsOnly) {
+  const DetectorSample orig = makeSample(someBoxes());
+  auto zeros = [](const PointCloud& c) {
+    std::size_t n = 0;
+    for (const Point& p : c.points) n += p.intensity == 0.0f;
+    return n;
+  };
+  SensorAugmentOptions o;
+  o.object_zero_probability = 1.0;
+  o.object_zero_min = o.object_zero_max = 0.6;
+  DetectorSample s = orig;
+  std::mt19937 rng(3);
+  SensorAugmenter(o).apply(&s, &rng);
+  std::size_t car_returns = 0, car_zeros = 0;
+  for (std::size_t i = 0; i < s.current.size(); ++i) {
+    const Point& p = orig.current.points[i];
+    const bool in_car = GtRegion(orig.boxes[0], GtDatabaseOptions()).contains(p) ||
+                        GtRegion(orig.boxes[1], GtDatabaseOptions()).contains(p);
+    if (in_car) {
+      ++car_returns;
+      car_zeros += s.current.points[i].intensity == 0.0f;
+    } else {
+      EXPECT_FLOAT_EQ(s.current.points[i].intensity, p.intensity) << i;  // pedestrian, cyclist, ground: unchanged
+    }
+  }
+  ASSERT_GT(car_returns, 100u);
+  EXPECT_NEAR(static_cast<double>(car_zeros) / static_cast<double>(car_returns), 0.6, 0.1);
+  EXPECT_GT(zeros(s.previous), zeros(orig.previous));  // the previous sweep's car returns too
+  // A class not listed is left alone.
+  o.object_zero_classes = {ObjectClass::Cyclist};
+  DetectorSample other = orig;
+  SensorAugmenter(o).apply(&other, &rng);
+  EXPECT_GT(zeros(other.current), zeros(orig.current));
+  EXPECT_LT(zeros(other.current), zeros(s.current));
+}
+
 TEST(SensorAugment, PreviousSweepDropoutClearsItAndInvalidatesVelocities) {
   DetectorSample s = makeSample(someBoxes());
   SensorAugmentOptions o;

@@ -199,6 +199,9 @@ TEST_P(DetectorOverfitTest, ReachesNearPerfectAPOnItsTrainingFrames) {
 
   DetectorOptions o = job.options;
   o.inference.model_path = job.out_model;
+  // This scene's ground runs under the sensor, where a real one sees none (its lowest beam meets the ground 3.7 m
+  // away): the ego box would crop returns the network was trained on.
+  o.inference.ego_box.reset();
   Detector detector(o);
   std::vector<std::vector<Box>> dets;
   std::vector<double> vel_err;

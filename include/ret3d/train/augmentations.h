@@ -79,6 +79,10 @@ void zeroIntensities(PointCloud* cloud, double fraction, std::mt19937* rng);
 // `gain`, clamped to [0, 1]; in the previous sweep where the object was then (the box moved back by its velocity over
 // `dt` seconds, into the previous sweep's frame). Returns the current sweep's points changed.
 std::size_t scaleObjectIntensity(DetectorSample* s, const Box& box, double gain, double dt);
+// Sets each return of `box` (both sweeps, as scaleObjectIntensity finds them) to intensity 0 with probability
+// `fraction` (a dark object: SensorAugmentOptions::object_zero_probability). Returns how many returns of either sweep
+// it turned from non-zero to 0.
+std::size_t darkenObject(DetectorSample* s, const Box& box, double fraction, double dt, std::mt19937* rng);
 // Removes the previous sweep; the velocities can no longer be seen, so they become invalid.
 void dropPreviousSweep(DetectorSample* s);
 // Moves the sensor: up by dz, then pitch and roll (rad) about its origin; points and boxes alike, yaw kept.
