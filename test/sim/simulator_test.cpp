@@ -135,8 +135,9 @@ TEST(Simulator, UrbanFramesLookLikeKittiAndBoxesHoldTheirPoints) {
 }
 
 TEST(Simulator, ActorsNeverInterpenetrate) {
-  // The traffic alone (no ray casting), 20 s of it: all boxes and the ego's, pairwise, every frame.
-  for (const char* preset : {"urban_street", "highway"}) {
+  // The traffic alone (no ray casting), 20 s of it: all boxes and the ego's, pairwise, every frame; the queue preset
+  // packs vehicles 1-4 m apart, trucks among them.
+  for (const char* preset : {"urban_street", "highway", "queue"}) {
     const SimConfig cfg = loadSimConfig(std::string(RET3D_SOURCE_DIR) + "/config/sim/" + preset + ".yaml");
     Rng rng(5);
     Scene scene;
