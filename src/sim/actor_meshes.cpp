@@ -13,6 +13,7 @@ const char* bodyName(CarBody b) {
     case CarBody::Hatchback: return "hatchback";
     case CarBody::Suv: return "suv";
     case CarBody::Van: return "van";
+    case CarBody::Truck: return "truck";
   }
   return "sedan";
 }
@@ -49,6 +50,11 @@ Profile profileOf(CarBody b) {
       return {{{-0.5f, 0.12f}, {0.5f, 0.12f}, {0.5f, 0.45f}, {0.44f, 0.58f}, {0.38f, 0.62f}, {-0.5f, 0.62f}},
               {{0.0f, 0.62f}, {0.38f, 0.62f}, {0.27f, 1.0f}, {0.0f, 1.0f}},
               {{-0.5f, 0.62f}, {0.0f, 0.62f}, {0.0f, 1.0f}, {-0.5f, 1.0f}}, 0.62f, 0.27f, -0.5f, 0.12f};
+    case CarBody::Truck:
+      // Chassis and cab below the belt, the cab's glazed upper half ahead of a cargo box the full height.
+      return {{{-0.5f, 0.14f}, {0.5f, 0.14f}, {0.5f, 0.45f}, {-0.5f, 0.45f}},
+              {{0.30f, 0.45f}, {0.5f, 0.45f}, {0.47f, 0.78f}, {0.30f, 0.78f}},
+              {{-0.5f, 0.45f}, {0.27f, 0.45f}, {0.27f, 1.0f}, {-0.5f, 1.0f}}, 0.45f, 0.27f, -0.5f, 0.14f};
   }
   return profileOf(CarBody::Sedan);
 }
@@ -150,35 +156,68 @@ TriangleMesh pedestrianMesh(const PersonShape& person, double phase, double swin
   return mesh;
 }
 
+namespace {
+
+// A bicycle's frame points for a bike Lb long (wheels included): hubs, bottom bracket, saddle, head tube, wheel radius.
+struct BikeFrame {
+  float r, wb;
+  V3 rear, front, bb, seat, head;
+};
+
+BikeFrame bikeFrame(float Lb) {
+  BikeFrame f;
+  f.r = std::clamp(0.19f * Lb, 0.3f, 0.36f);
+  f.wb = Lb - 2 * f.r;
+  f.rear = V3(-0.5f * f.wb, 0, f.r);
+  f.front = V3(0.5f * f.wb, 0, f.r);
+  f.bb = V3(-0.05f * f.wb, 0, 0.3f);
+  f.seat = V3(-0.22f * f.wb, 0, f.r + 0.58f);
+  f.head = V3(0.38f * f.wb, 0, f.r + 0.52f);
+  return f;
+}
+
+// Wheels (tyre rings of beams), frame tubes, handlebar and saddle; no cranks.
+void addBicycle(TriangleMesh& mesh, const BikeFrame& f, float half_bar, const ActorSurfaces& s) {
+  for (const V3& hub : {f.rear, f.front}) {
+    const int n = 14;
+    for (int i = 0; i < n; ++i) {
+      const float a0 = 2 * static_cast<float>(M_PI) * i / n, a1 = 2 * static_cast<float>(M_PI) * (i + 1) / n;
+      mesh.addBeam(hub + V3(f.r * std::cos(a0), 0, f.r * std::sin(a0)),
+                   hub + V3(f.r * std::cos(a1), 0, f.r * std::sin(a1)), 0.05f, s.tire);
+    }
+    mesh.addBeam(hub + V3(0, -0.05f, 0), hub + V3(0, 0.05f, 0), 0.06f, s.metal);  // hub
+  }
+  mesh.addBeam(f.rear, f.bb, 0.035f, s.metal);
+  mesh.addBeam(f.rear, f.seat, 0.03f, s.metal);
+  mesh.addBeam(f.bb, f.seat, 0.04f, s.metal);
+  mesh.addBeam(f.bb, f.head, 0.045f, s.metal);
+  mesh.addBeam(f.seat + V3(0, 0, -0.05f), f.head, 0.04f, s.metal);
+  mesh.addBeam(f.head, f.front, 0.04f, s.metal);
+  const V3 bar = f.head + V3(0.02f, 0, 0.12f);
+  mesh.addBeam(bar + V3(0, -half_bar, 0), bar + V3(0, half_bar, 0), 0.035f, s.metal);
+  mesh.addBox(translation(f.seat.x(), 0, f.seat.z() + 0.03f), V3(0.25f, 0.12f, 0.05f), s.tire);
+}
+
+}  // namespace
+
+TriangleMesh bicycleMesh(double length, double bar_width, const ActorSurfaces& s) {
+  TriangleMesh mesh;
+  const BikeFrame f = bikeFrame(static_cast<float>(length));
+  addBicycle(mesh, f, 0.5f * static_cast<float>(bar_width), s);
+  for (int side = -1; side <= 1; side += 2)  // cranks at rest, one up, one down
+    mesh.addBeam(f.bb + V3(0, side * 0.12f, 0), f.bb + V3(0, side * 0.12f, side * 0.17f), 0.03f, s.metal);
+  return mesh;
+}
+
 TriangleMesh cyclistMesh(const RiderShape& rider, double crank, const ActorSurfaces& s) {
   const float m = static_cast<float>(kLabelMargin);
   const float Lb = static_cast<float>(rider.length) - 2 * m, H = static_cast<float>(rider.stature);
   const float half_bar = 0.5f * static_cast<float>(rider.bar_width), lean = static_cast<float>(rider.lean);
   TriangleMesh mesh;
-  // Bicycle: wheels (tyre rings of beams), frame tubes, handlebar, cranks.
-  const float r = std::clamp(0.19f * Lb, 0.3f, 0.36f);
-  const float wb = Lb - 2 * r;
-  const V3 rear(-0.5f * wb, 0, r), front(0.5f * wb, 0, r);
-  for (const V3& hub : {rear, front}) {
-    const int n = 14;
-    for (int i = 0; i < n; ++i) {
-      const float a0 = 2 * static_cast<float>(M_PI) * i / n, a1 = 2 * static_cast<float>(M_PI) * (i + 1) / n;
-      mesh.addBeam(hub + V3(r * std::cos(a0), 0, r * std::sin(a0)), hub + V3(r * std::cos(a1), 0, r * std::sin(a1)),
-                   0.05f, s.tire);
-    }
-    mesh.addBeam(hub + V3(0, -0.05f, 0), hub + V3(0, 0.05f, 0), 0.06f, s.metal);  // hub
-  }
-  const V3 bb(-0.05f * wb, 0, 0.3f);
-  const V3 seat(-0.22f * wb, 0, r + 0.58f), head(0.38f * wb, 0, r + 0.52f);
-  mesh.addBeam(rear, bb, 0.035f, s.metal);
-  mesh.addBeam(rear, seat, 0.03f, s.metal);
-  mesh.addBeam(bb, seat, 0.04f, s.metal);
-  mesh.addBeam(bb, head, 0.045f, s.metal);
-  mesh.addBeam(seat + V3(0, 0, -0.05f), head, 0.04f, s.metal);
-  mesh.addBeam(head, front, 0.04f, s.metal);
+  const BikeFrame frame = bikeFrame(Lb);
+  addBicycle(mesh, frame, half_bar, s);
+  const V3 bb = frame.bb, seat = frame.seat, head = frame.head;
   const V3 bar = head + V3(0.02f, 0, 0.12f);
-  mesh.addBeam(bar + V3(0, -half_bar, 0), bar + V3(0, half_bar, 0), 0.035f, s.metal);
-  mesh.addBox(translation(seat.x(), 0, seat.z() + 0.03f), V3(0.25f, 0.12f, 0.05f), s.tire);
   // Rider: hips on the saddle, torso leaning to the bars, legs on the pedals (two-link inverse kinematics).
   const float thigh = 0.245f * H, shin = 0.25f * H, crank_r = 0.17f;
   const V3 hip = seat + V3(-0.03f, 0, 0.08f);

@@ -172,6 +172,39 @@ void drawCar(Actor& a, const SimConfig& config, Rng& rng) {
   a.height = std::clamp(rng.normal(d[k].h, 0.05), 1.3, 2.0);
   a.box_offset = V2::Zero();
   a.surfaces = drawSurfaces(config, rng);
+  if (!config.paint.empty()) a.surfaces.paint.reflectivity = static_cast<float>(drawPaint(config, rng));
+  a.mesh = actorMesh(a);
+}
+
+double drawPaint(const SimConfig& config, Rng& rng) {
+  if (config.paint.empty()) return drawSurface(config, "paint", rng).reflectivity;
+  double total = 0;
+  for (const PaintMode& m : config.paint) total += m.weight;
+  double u = rng.uniform(0, total);
+  std::size_t k = 0;
+  while (k + 1 < config.paint.size() && u >= config.paint[k].weight) u -= config.paint[k++].weight;
+  return std::max(0.005, draw(rng, config.paint[k].reflectivity));
+}
+
+void drawVehicle(Actor& a, const SimConfig& config, Rng& rng) {
+  const TrafficConfig& t = config.traffic;
+  const double u = t.truck + t.delivery_van > 0 ? rng.uniform() : 1.0;
+  if (u >= t.truck + t.delivery_van) {
+    drawCar(a, config, rng);
+    return;
+  }
+  // KITTI's Truck (box trucks: 10.1 x 2.6 x 3.3 m on average in KITTI object; city box trucks shorter) and Van (5.1 x
+  // 1.9 x 2.2 m), labelled with their own type, which KITTI-style training ignores for Car.
+  const bool truck = u < t.truck;
+  a.kind = ActorKind::Obstacle;
+  a.kitti_type = truck ? "Truck" : "Van";
+  a.body = truck ? CarBody::Truck : CarBody::Van;
+  a.length = truck ? std::clamp(rng.normal(8.0, 1.5), 6.0, 11.5) : std::clamp(rng.normal(5.1, 0.35), 4.4, 6.2);
+  a.width = truck ? std::clamp(rng.normal(2.45, 0.08), 2.25, 2.6) : std::clamp(rng.normal(1.95, 0.07), 1.8, 2.15);
+  a.height = truck ? std::clamp(rng.normal(3.2, 0.25), 2.7, 3.8) : std::clamp(rng.normal(2.3, 0.15), 1.95, 2.8);
+  a.box_offset = V2::Zero();
+  a.surfaces = drawSurfaces(config, rng);
+  a.surfaces.paint.reflectivity = static_cast<float>(drawPaint(config, rng));
   a.mesh = actorMesh(a);
 }
 
@@ -315,13 +348,18 @@ double Traffic::leaderGap(const Actor& a, double horizon, double* leader_speed) 
 void Traffic::advance(Actor& a, double t, double dt, Rng& rng) {
   if (!a.active || !a.moving || !a.path) return;
   const TrafficConfig& tc = config_.traffic;
-  const Range speeds = &a == &ego ? tc.ego_speed
+  const Range speeds = a.queued ? tc.queue.speed
+                       : &a == &ego ? tc.ego_speed
                        : a.kind == ActorKind::Pedestrian ? tc.pedestrian_speed
                        : a.kind == ActorKind::Cyclist ? tc.cyclist_speed : tc.car_speed;
-  // New target speed now and then; sometimes a stop (vehicles only; pedestrians just vary their pace).
-  if (t >= a.next_change) {
+  const double stop_probability = a.queued ? tc.queue.stop_probability : tc.stop_probability;
+  if (a.queued && &a == &ego) {
+    // The queued ego only follows: it stops and goes with the vehicle ahead.
+    a.v_target = speeds.hi + 0.5;
+  } else if (t >= a.next_change) {
+    // New target speed now and then; sometimes a stop (vehicles only; pedestrians just vary their pace).
     a.next_change = t + draw(rng, tc.speed_change_interval);
-    if (a.kind != ActorKind::Pedestrian && rng.chance(tc.stop_probability)) {
+    if (a.kind != ActorKind::Pedestrian && rng.chance(stop_probability)) {
       a.v_target = 0;
       a.stop_until = t + rng.uniform(2, 6);
     } else {
@@ -333,7 +371,9 @@ void Traffic::advance(Actor& a, double t, double dt, Rng& rng) {
     a.v_target = std::max(draw(rng, speeds), 0.5 * speeds.hi);
     a.stop_until = -1;
   }
-  const Idm p = idmOf(a.kind);
+  Idm p = idmOf(a.kind);
+  if (a.queued) p.T = tc.queue.headway;
+  if (a.jam_gap >= 0) p.s0 = a.jam_gap;
   const double horizon = a.kind == ActorKind::Pedestrian ? 6.0 : std::max(15.0, a.v * 4 + 10);
   double vl = 0;
   double gap = leaderGap(a, horizon, &vl);
@@ -458,6 +498,7 @@ bool nearRoute(const Path& route, const V2& p, double r) {
 
 void Traffic::spawn(Rng& rng, double view_range) {
   spawnEgo(rng);
+  if (config_.traffic.queue.probability > 0 && rng.chance(config_.traffic.queue.probability)) spawnQueues(rng);
   const Road& main = scene_.roads[0];
   const Path route = main.center.slice(std::max(0.0, scene_.ego_start - 5), scene_.ego_start + scene_.ego_reach + 5, 4.0);
   for (const Lane& l : scene_.lanes) {
@@ -500,6 +541,42 @@ void Traffic::spawnEgo(Rng& rng) {
   ego_pose_.linear() = Eigen::AngleAxisd(ego.yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
 }
 
+void Traffic::spawnQueues(Rng& rng) {
+  const QueueConfig& q = config_.traffic.queue;
+  ego.queued = true;
+  ego.v = 0;
+  ego.jam_gap = draw(rng, q.gap);
+  for (const Lane& l : scene_.lanes) {
+    if (l.road != 0 || l.kind != Lane::Traffic || l.side >= 0) continue;
+    const bool own = l.path == ego.path;
+    // The queue runs through the ego's station: its own lane from the ego's bumpers, the others shifted at random.
+    const double s0 = own ? ego.s : ego.s + rng.uniform(-6, 6);
+    const double half = own ? 0.5 * ego.length : 0.0;
+    for (int dir = 1; dir >= -1; dir -= 2) {
+      const int n = static_cast<int>(std::round(draw(rng, dir > 0 ? q.ahead : q.behind)));
+      double edge = s0 + dir * half;  // the last placed vehicle's bumper facing the next
+      for (int k = 0; k < n; ++k) {
+        Actor a;
+        // Right ahead of the ego: a car, seen from behind.
+        if (own && dir > 0 && k == 0) drawCar(a, config_, rng);
+        else drawVehicle(a, config_, rng);
+        const double gap = draw(rng, q.gap);
+        a.s = edge + dir * (gap + 0.5 * a.length);
+        edge = a.s + dir * 0.5 * a.length;
+        if (a.s < 5 || a.s > l.path->length() - 10) break;
+        a.path = l.path;
+        a.queued = true;
+        a.jam_gap = gap;
+        a.v = 0;
+        a.v_cruise = a.v_target = draw(rng, q.speed);
+        a.next_change = draw(rng, config_.traffic.speed_change_interval);
+        findStops(a);
+        tryAdd(a);
+      }
+    }
+  }
+}
+
 void Traffic::tryAdd(Actor a) {
   place(a);
   if (overlapsAny(a, worldBox(a))) return;
@@ -530,7 +607,7 @@ void Traffic::spawnParked(const Lane& l, const Path& route, double view_range, R
         scene_.onOtherCarriageway(pp.p, l.road, 7.0))
       continue;
     Actor a;
-    drawCar(a, config_, rng);
+    drawVehicle(a, config_, rng);
     a.path = l.path;
     a.s = s;
     a.moving = false;
@@ -551,7 +628,7 @@ void Traffic::spawnCars(const Lane& l, Rng& rng) {
   const int n = static_cast<int>(std::round(tc.car_density * len / 100.0 * rng.uniform(0.8, 1.2)));
   for (int i = 0; i < n; ++i) {
     Actor a;
-    drawCar(a, config_, rng);
+    drawVehicle(a, config_, rng);
     a.path = l.path;
     a.s = rng.uniform(5, len - 10);
     a.v_cruise = a.v_target = draw(rng, tc.car_speed);

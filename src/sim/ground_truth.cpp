@@ -41,7 +41,7 @@ std::vector<ObjectTruth> labelFrame(const std::vector<Actor>& actors, const RayC
   std::vector<ObjectTruth> out;
   for (std::size_t i = 0; i < actors.size(); ++i) {
     const Actor& a = actors[i];
-    if (!a.active || !a.labelled || a.objectClass() == ObjectClass::Unknown) continue;
+    if (!a.active || !a.labelled || (a.objectClass() == ObjectClass::Unknown && a.kitti_type.empty())) continue;
     ObjectTruth o;
     o.actor = i;
     o.box = transformBox(worldBox(a), T_lidar_world);
@@ -114,6 +114,7 @@ std::vector<ObjectTruth> labelFrame(const std::vector<Actor>& actors, const RayC
 
       // Camera: where the mesh projects, how much is outside the image, how much is hidden behind other things.
       o.label = kitti::boxToLabel(o.box, calib, opt.image_size);
+      if (!a.kitti_type.empty()) o.label.type = a.kitti_type;
       o.label.frame = frame;
       o.label.score.reset();  // ground truth, not a detection
       const Eigen::Isometry3d T_lidar_actor = T_lidar_world * actorPose(a);

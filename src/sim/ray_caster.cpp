@@ -290,11 +290,16 @@ Sweep RayCaster::cast(const Eigen::Isometry3d& T, std::uint64_t seed, int frame,
             }
             const double r = range + sensor_.range_noise_sigma * rng.normal();
             if (r < sensor_.min_range || r > sensor_.max_range) continue;
-            double inten = surf.reflectivity * std::pow(cos_inc, sensor_.incidence_exponent) *
-                           std::exp(-sensor_.range_attenuation * range) * sensor_.intensity_gain +
-                           sensor_.intensity_noise_sigma * rng.normal();
-            inten = std::clamp(inten, 0.0, 1.0);
+            const double signal = surf.reflectivity * std::pow(cos_inc, sensor_.incidence_exponent) *
+                                  std::exp(-sensor_.range_attenuation * range) * sensor_.intensity_gain;
+            double inten = std::clamp(signal + sensor_.intensity_noise_sigma * rng.normal(), 0.0, 1.0);
             if (inten < sensor_.zero_intensity_below) inten = 0.0;
+            if (sensor_.weak_return_zero_below > 0) {
+              // The detection floor (a draw only for weak returns, so brighter rays keep their noise).
+              const WeakReturn weak = weakReturn(sensor_, signal);
+              if (weak.zero) inten = 0.0;
+              if (weak.lost > 0 && rng.uniform() < weak.lost) continue;
+            }
             if (sensor_.zero_intensity_near > 0 || sensor_.zero_intensity_far > 0) {
               const double ramp = std::clamp((r - sensor_.zero_intensity_near_range) /
                                                  (sensor_.zero_intensity_far_range - sensor_.zero_intensity_near_range),

@@ -43,6 +43,15 @@ int nearestBeam(const SensorModel& sensor, double elevation_deg) {
   return static_cast<int>(ring);
 }
 
+WeakReturn weakReturn(const SensorModel& sensor, double signal) {
+  WeakReturn w;
+  const double zero = sensor.weak_return_zero_below, lost = sensor.weak_return_lost_below;
+  if (signal >= zero) return w;
+  w.zero = true;
+  if (lost > 0 || zero > 0) w.lost = std::clamp((zero - signal) / std::max(zero - lost, 1e-9), 0.0, 1.0);
+  return w;
+}
+
 static SensorModel readSensorModel(YamlReader r) {
   SensorModel s;
   s.source = r.origin();
@@ -59,7 +68,9 @@ static SensorModel readSensorModel(YamlReader r) {
            {"intensity_noise_sigma", &s.intensity_noise_sigma},   {"zero_intensity_below", &s.zero_intensity_below},
            {"zero_intensity_near", &s.zero_intensity_near},       {"zero_intensity_far", &s.zero_intensity_far},
            {"zero_intensity_near_range", &s.zero_intensity_near_range},
-           {"zero_intensity_far_range", &s.zero_intensity_far_range}})
+           {"zero_intensity_far_range", &s.zero_intensity_far_range},
+           {"weak_return_zero_below", &s.weak_return_zero_below},
+           {"weak_return_lost_below", &s.weak_return_lost_below}})
     r.get(key, value, -1e6, 1e6);
   if (r.get("elevation_deg", &s.elevation_deg)) {
     if (s.elevation_deg.empty()) r.fail("elevation_deg", "expected a list of angles");
@@ -99,6 +110,10 @@ static SensorModel readSensorModel(YamlReader r) {
   r.within("zero_intensity_below", s.zero_intensity_below, 0, 1);
   r.within("zero_intensity_far", s.zero_intensity_far, 0, 1);
   r.within("zero_intensity_near", s.zero_intensity_near, 0, 1);
+  r.within("weak_return_zero_below", s.weak_return_zero_below, 0, 1);
+  r.within("weak_return_lost_below", s.weak_return_lost_below, 0, 1);
+  if (s.weak_return_lost_below > 0 && s.weak_return_lost_below >= s.weak_return_zero_below)
+    r.fail("weak_return_lost_below", "must be below weak_return_zero_below");
   if (s.zero_intensity_far_range <= s.zero_intensity_near_range)
     r.fail("zero_intensity_far_range", "must be above zero_intensity_near_range");
   // Ring 0 is the lowest beam.

@@ -51,7 +51,7 @@ void SequenceWriter::writeFrame(int frame, const PointCloud& cloud, const std::v
     labels_.push_back(o.label);
     const Box& b = o.box;
     std::snprintf(line, sizeof(line), "%d %d %s %.4f %.4f %.4f %.4f %.4f %.4f %.5f %.3f %.3f %u %u %u %.4f %.4f %.4f\n",
-                  frame, o.label.track_id, className(b.label), b.x, b.y, b.z, b.length, b.width, b.height, b.yaw, b.vx,
+                  frame, o.label.track_id, o.label.type.c_str(), b.x, b.y, b.z, b.length, b.width, b.height, b.yaw, b.vx,
                   b.vy, b.num_points, o.hits, o.unoccluded, o.visible_fraction, o.camera_truncation, o.camera_visible);
     info_ += line;
   }

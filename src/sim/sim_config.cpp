@@ -92,6 +92,30 @@ void readClutter(YamlReader r, ClutterConfig* o) {
   readRange(r, "bush_spacing", &o->bush_spacing, 0, kBig);
   readRange(r, "bush_radius", &o->bush_radius, 0.1, 5);
   readRange(r, "bollard_spacing", &o->bollard_spacing, 0, kBig);
+  readRange(r, "pole_radius", &o->pole_radius, 0.02, 1);
+  readRange(r, "sign_height", &o->sign_height, 1, 8);
+  readRange(r, "sign_plate", &o->sign_plate, 0.1, 3);
+  readRange(r, "bollard_radius", &o->bollard_radius, 0.02, 1);
+  readRange(r, "bollard_height", &o->bollard_height, 0.1, 3);
+  readRange(r, "post_spacing", &o->post_spacing, 0, kBig);
+  readRange(r, "post_radius", &o->post_radius, 0.01, 0.5);
+  readRange(r, "post_height", &o->post_height, 0.3, 10);
+  readRange(r, "bicycle_spacing", &o->bicycle_spacing, 0, kBig);
+  r.get("railing_probability", &o->railing_probability, 0, 1);
+  readRange(r, "railing_height", &o->railing_height, 0.3, 3);
+  r.get("low_wall_probability", &o->low_wall_probability, 0, 1);
+  readRange(r, "low_wall_height", &o->low_wall_height, 0.1, 2);
+  r.finish();
+}
+
+void readQueue(YamlReader r, QueueConfig* o) {
+  r.get("probability", &o->probability, 0, 1);
+  readRange(r, "ahead", &o->ahead, 0, 50);
+  readRange(r, "behind", &o->behind, 0, 50);
+  readRange(r, "gap", &o->gap, 0.5, 20);
+  readRange(r, "speed", &o->speed, 0, 20);
+  r.get("stop_probability", &o->stop_probability, 0, 1);
+  r.get("headway", &o->headway, 0.1, 5);
   r.finish();
 }
 
@@ -116,7 +140,27 @@ void readTraffic(YamlReader r, TrafficConfig* o) {
   r.get("hatchback", &o->hatchback, 0, 1);
   r.get("suv", &o->suv, 0, 1);
   r.get("van", &o->van, 0, 1);
+  r.get("truck", &o->truck, 0, 1);
+  r.get("delivery_van", &o->delivery_van, 0, 1);
+  if (r.has("queue")) readQueue(r.child("queue"), &o->queue);
   r.finish();
+  if (o->truck + o->delivery_van > 1) r.fail("delivery_van", "truck + delivery_van above 1");
+}
+
+void readPaint(YamlReader& r, std::vector<PaintMode>* out) {
+  const bool has = r.has("paint");
+  std::vector<YamlReader> modes = r.children("paint");
+  if (has && modes.empty()) r.fail("paint", "expected a list of {weight, reflectivity: [lo, hi]}");
+  double total = 0;
+  for (YamlReader& m : modes) {
+    PaintMode p;
+    m.get("weight", &p.weight, 0, 1000);
+    readRange(m, "reflectivity", &p.reflectivity, 0.0, 1.0);
+    m.finish();
+    total += p.weight;
+    out->push_back(p);
+  }
+  if (has && total <= 0) r.fail("paint", "the weights sum to zero");
 }
 
 void readMaterials(YamlReader r, std::map<std::string, MaterialConfig>* materials) {
@@ -155,6 +199,7 @@ static SimConfig readSimConfig(YamlReader r) {
   readClutter(r.child("clutter"), &c.clutter);
   readTraffic(r.child("traffic"), &c.traffic);
   readMaterials(r.child("materials"), &c.materials);
+  readPaint(r, &c.paint);
   r.finish();
   const TrafficConfig& t = c.traffic;
   if (t.sedan + t.hatchback + t.suv + t.van <= 0) r.fail("traffic.sedan", "body type mix sums to zero");

@@ -137,7 +137,7 @@ SequenceReport simulateSequence(const SimOptions& opt, int index,
     fr.points = cloud.size();
     fr.objects = truth.size();
     for (const ObjectTruth& o : truth) {
-      const std::string cls = className(o.box.label);
+      const std::string cls = o.label.type;  // Car, Pedestrian, Cyclist, and Van or Truck
       ++report.objects[cls];
       tracks.insert({cls, o.box.track_id});
       report.object_points += o.box.num_points;

@@ -154,7 +154,8 @@ int runSim(const SimArgs& args) {
               << fmt(*std::max_element(points.begin(), points.end()), 0) << "\n";
   }
   std::cout << "  objects per class    ";
-  for (const char* c : {"Car", "Pedestrian", "Cyclist"}) {
+  for (const char* c : {"Car", "Pedestrian", "Cyclist", "Van", "Truck"}) {
+    if (objects[c] == 0 && (std::string(c) == "Van" || std::string(c) == "Truck")) continue;  // only when drawn
     std::cout << c << " " << objects[c] << " (" << tracks[c] << " tracks, in " << sequences_with[c] << "/"
               << reports.size() << " sequences)  ";
   }

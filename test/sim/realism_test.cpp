@@ -155,6 +155,7 @@ TEST(Realism, ZeroIntensityReturnsAreKeptWithIntensityZero) {
   sensor.zero_intensity_below = 0;
   sensor.zero_intensity_near = 0;
   sensor.zero_intensity_far = 0;
+  sensor.weak_return_zero_below = sensor.weak_return_lost_below = 0;  // the detection floor: test/sim/street_test.cpp
   const TriangleMesh dark = groundScene(0.08f);
   const Sweep plain = castOnce(sensor, dark);
   sensor.zero_intensity_below = 0.1;

@@ -40,7 +40,7 @@ TEST(SensorModel, BadFileNamesTheKey) {
 }
 
 TEST(SimConfig, PresetsLoadAndTyposAreErrors) {
-  for (const char* name : {"urban_street", "highway"}) {
+  for (const char* name : {"urban_street", "highway", "queue"}) {
     const SimConfig c = loadSimConfig(std::string(RET3D_SOURCE_DIR) + "/config/sim/" + name + ".yaml");
     EXPECT_EQ(c.name, name);
     EXPECT_GT(c.traffic.car_density, 0);

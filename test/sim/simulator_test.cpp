@@ -100,7 +100,9 @@ TEST(Simulator, UrbanFramesLookLikeKittiAndBoxesHoldTheirPoints) {
   std::map<int, int> near_objects;
   for (int f = 0; f < 4; ++f) {
     const PointCloud cloud = kitti::readVelodyne(ds.velodynePath("0000", f));
-    EXPECT_GT(cloud.size(), 90000u) << "frame " << f;
+    // 98 500 per frame in this scene before dark paints and the detection floor, 84 000 since: its many parked cars
+    // near the sensor, 28 % of them black or dark grey, lose most of their returns (docs/SIMULATOR.md).
+    EXPECT_GT(cloud.size(), 80000u) << "frame " << f;
     EXPECT_LT(cloud.size(), 140000u) << "frame " << f;
     for (const auto& p : cloud.points) {
       ASSERT_GE(p.intensity, 0.0f);
@@ -133,8 +135,9 @@ TEST(Simulator, UrbanFramesLookLikeKittiAndBoxesHoldTheirPoints) {
 }
 
 TEST(Simulator, ActorsNeverInterpenetrate) {
-  // The traffic alone (no ray casting), 20 s of it: all boxes and the ego's, pairwise, every frame.
-  for (const char* preset : {"urban_street", "highway"}) {
+  // The traffic alone (no ray casting), 20 s of it: all boxes and the ego's, pairwise, every frame; the queue preset
+  // packs vehicles 1-4 m apart, trucks among them.
+  for (const char* preset : {"urban_street", "highway", "queue"}) {
     const SimConfig cfg = loadSimConfig(std::string(RET3D_SOURCE_DIR) + "/config/sim/" + preset + ".yaml");
     Rng rng(5);
     Scene scene;

@@ -14,7 +14,8 @@ namespace sim {
 // Gap between a mesh and its label box on each side (m): about two range-noise sigmas.
 inline constexpr double kLabelMargin = 0.05;
 
-enum class CarBody { Sedan = 0, Hatchback = 1, Suv = 2, Van = 3 };
+// Truck: a box truck (a cab lower than its cargo box), for KITTI's Truck class.
+enum class CarBody { Sedan = 0, Hatchback = 1, Suv = 2, Van = 3, Truck = 4 };
 const char* bodyName(CarBody b);
 
 struct ActorSurfaces {
@@ -45,6 +46,8 @@ struct RiderShape {
 // A bicycle and rider of build `r`, crank at angle `crank` (radians). Origin on the ground at the middle of the
 // wheelbase.
 TriangleMesh cyclistMesh(const RiderShape& r, double crank, const ActorSurfaces& s);
+// A parked bicycle without a rider, `length` long with handlebars `bar_width` across, in the same frame.
+TriangleMesh bicycleMesh(double length, double bar_width, const ActorSurfaces& s);
 
 }  // namespace sim
 }  // namespace ret3d

@@ -7,6 +7,7 @@
 
 #include <memory>
 #include <optional>
+#include <string>
 #include <unordered_map>
 #include <vector>
 
@@ -22,13 +23,18 @@ namespace sim {
 
 inline constexpr int kPhaseSteps = 16;
 
-enum class ActorKind { Car, Pedestrian, Cyclist, Obstacle };  // Obstacle: a replayed Van/Truck, drawn, not labelled
+// Obstacle: a vehicle of another KITTI class (a replayed Van/Truck, drawn, not labelled; a generated truck or delivery
+// van, labelled with its `kitti_type`).
+enum class ActorKind { Car, Pedestrian, Cyclist, Obstacle };
 
 struct Actor {
   std::uint32_t track_id = 0;   // 1-based and unique in the sequence; the KITTI track id is track_id - 1
   ActorKind kind = ActorKind::Car;
   CarBody body = CarBody::Sedan;
   bool labelled = true;
+  std::string kitti_type;       // the label_02 type of an Obstacle ("Van", "Truck"); empty = from the class
+  bool queued = false;          // in a stop-and-go queue (TrafficConfig::queue): creeps, stops, keeps `jam_gap`
+  double jam_gap = -1;          // IDM jam distance (m); < 0 = the kind's
   // Label box size and where its centre sits in the actor frame (x forward; the mesh origin is on the ground).
   double length = 4, width = 1.7, height = 1.5;
   Eigen::Vector2d box_offset = Eigen::Vector2d::Zero();
@@ -73,6 +79,10 @@ Eigen::Isometry3d actorPose(const Actor& a);
 TriangleMesh actorMesh(const Actor& a);
 // A car body type and label size drawn from the config's mix, around KITTI's Car distribution.
 void drawCar(Actor& a, const SimConfig& config, Rng& rng);
+// A vehicle: a truck or a delivery van with the config's probabilities (KITTI Truck / Van), else a car (drawCar).
+void drawVehicle(Actor& a, const SimConfig& config, Rng& rng);
+// A car paint reflectivity from the config's colour mixture (SimConfig::paint); without one, the `paint` material.
+double drawPaint(const SimConfig& config, Rng& rng);
 
 class Traffic {
  public:
@@ -95,6 +105,9 @@ class Traffic {
   // spawn() in parts; they draw from rng in this order: the ego, then lane by lane its parked cars, moving cars,
   // cyclists or pedestrians. Actors far from the ego's `route` are not drawn.
   void spawnEgo(Rng& rng);
+  // Stop-and-go queues in every lane of the ego's direction, the ego standing in one (TrafficConfig::queue); the
+  // vehicle right ahead of the ego is a car.
+  void spawnQueues(Rng& rng);
   void spawnParked(const Lane& l, const Path& route, double view_range, Rng& rng);
   void spawnCars(const Lane& l, Rng& rng);
   void spawnCyclists(const Lane& l, const Path& route, double view_range, Rng& rng);

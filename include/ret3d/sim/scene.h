@@ -41,12 +41,22 @@ struct Intersection {
   double light_phase = 0;       // s offset of the traffic light cycle
 };
 
+// A roadside structure in the static mesh, as built (for tests and statistics).
+struct Furniture {
+  enum Kind { Trunk, LampPole, SignPole, Post, Bollard, Bicycle };
+  Kind kind = Trunk;
+  Eigen::Vector2d p = Eigen::Vector2d::Zero();
+  double radius = 0;            // of the trunk or pole (bicycle: 0)
+  double height = 0;            // top above the ground (trunk: to the crown's base)
+};
+
 struct Scene {
   std::vector<Road> roads;      // roads[0] is the main road, the ego's
   std::vector<Lane> lanes;
   std::vector<Intersection> intersections;
   std::vector<double> crossings;  // stations on the main road where pedestrians cross (crosswalks, intersections)
   TriangleMesh mesh;            // all static geometry
+  std::vector<Furniture> furniture;  // trunks, poles, posts, bollards and parked bicycles in it
   double ego_start = 0;         // ego's station on the main road at frame 0
   double ego_reach = 0;         // furthest the ego can drive in the sequence
   double terrain_slope[2] = {0, 0};  // right / left of the main road

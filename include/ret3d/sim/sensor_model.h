@@ -37,6 +37,12 @@ struct SensorModel {
   double zero_intensity_far = 0.0;
   double zero_intensity_near_range = 20.0;
   double zero_intensity_far_range = 50.0;
+  // Detection floor on the signal before noise, reflectivity * cos(incidence)^k * exp(-a r) * gain: a return weaker
+  // than `weak_return_zero_below` is reported with intensity 0 (the receiver barely triggers: black paint, tinted glass,
+  // tyres), and is lost with a probability rising linearly from 0 there to 1 at `weak_return_lost_below`.
+  // 0 = off.
+  double weak_return_zero_below = 0.0;
+  double weak_return_lost_below = 0.0;
   // The ego car's body around the sensor, an axis-aligned box [x_min, x_max, y_min, y_max, z_min, z_max] in the
   // LiDAR frame: rays passing through it return nothing (real scans' lowest beams hit the roof, hood and boot).
   // Empty = no body.
@@ -51,6 +57,14 @@ struct SensorModel {
 
 // The beam (ring) whose elevation is nearest `elevation_deg`, for scans without a ring (KITTI .bin); -1 without beams.
 int nearestBeam(const SensorModel& sensor, double elevation_deg);
+
+// What the detection floor does to a return of noiseless signal `signal`: the probability it is lost, and whether a
+// kept one reads intensity 0.
+struct WeakReturn {
+  double lost = 0;
+  bool zero = false;
+};
+WeakReturn weakReturn(const SensorModel& sensor, double signal);
 
 // Reads a sensor YAML; the beams are an explicit `elevation_deg` list or `elevation_blocks` of evenly spaced beams.
 // Throws std::runtime_error naming the file and key on bad input.

@@ -5,6 +5,7 @@
 
 #include <map>
 #include <string>
+#include <vector>
 
 namespace ret3d {
 namespace sim {
@@ -78,6 +79,42 @@ struct ClutterConfig {
   Range bush_spacing{0, 0};             // along each side; 0..0 = none
   Range bush_radius{0.4, 1.0};
   Range bollard_spacing{0, 0};          // along each side; 0..0 = none
+  // The sizes of roadside structures (defaults: the sizes the simulator always drew). A range with lo == hi is not
+  // drawn, so the defaults leave the scene of a seed unchanged.
+  Range pole_radius{0.1, 0.1};          // street lights
+  Range sign_height{2.3, 2.3};          // sign pole top above the kerb (m)
+  Range sign_plate{0.6, 0.6};           // plate side (m)
+  Range bollard_radius{0.08, 0.08};
+  Range bollard_height{0.7, 1.1};       // above the kerb, plus 0.1 m
+  // Street furniture drawn from a stream of its own (none by default): thin posts (parking meters, pipes, posts of
+  // ticket machines), groups of parked bicycles (unlabelled: KITTI labels no bicycle without a rider), pedestrian
+  // railings along the kerb and low walls or planters at the sidewalk's outer edge.
+  Range post_spacing{0, 0};             // along each side; 0..0 = none
+  Range post_radius{0.03, 0.08};
+  Range post_height{1.0, 3.0};
+  Range bicycle_spacing{0, 0};          // groups of 1-4 parked bicycles; 0..0 = none
+  double railing_probability = 0.0;     // per frontage slot: a railing at the kerb
+  Range railing_height{0.9, 1.2};
+  double low_wall_probability = 0.0;    // per frontage slot: a low wall or planter at the sidewalk's outer edge
+  Range low_wall_height{0.2, 0.7};
+};
+
+// A group of car colours: its share of cars and the range (uniform) of its paint's reflectivity at 905 nm.
+struct PaintMode {
+  double weight = 1.0;
+  Range reflectivity{0.3, 0.4};
+};
+
+// Stop-and-go queues: in a sequence drawn as a queue, the ego starts standing behind a vehicle in its lane, with
+// queues ahead of and behind it in every lane of its direction; queued vehicles creep and stop.
+struct QueueConfig {
+  double probability = 0.0;             // fraction of sequences that start in a queue (0 = none)
+  Range ahead{4, 10};                   // vehicles ahead of the ego in each lane of its direction
+  Range behind{1, 4};                   // and behind it
+  Range gap{1.0, 4.0};                  // bumper to bumper at standstill (m): the IDM jam distance of queued vehicles
+  Range speed{0.3, 3.0};                // creeping speed (m/s)
+  double stop_probability = 0.5;        // a new target speed of a queued vehicle is a stop
+  double headway = 0.8;                 // IDM time headway of queued vehicles (s)
 };
 
 struct TrafficConfig {
@@ -97,7 +134,11 @@ struct TrafficConfig {
   Range speed_change_interval{3, 10};   // s between new target speeds
   double stop_probability = 0.1;        // chance a new target speed is a stop (0 m/s for a while)
   double traffic_light_cycle = 30.0;    // s; main road and cross road green alternate; 0 = no lights
-  double sedan = 0.4, hatchback = 0.25, suv = 0.25, van = 0.1;  // body type mix
+  double sedan = 0.4, hatchback = 0.25, suv = 0.25, van = 0.1;  // body type mix of Car
+  // Vehicles of KITTI's other classes, as fractions of all moving, parked and queued vehicles: box trucks (labelled
+  // Truck) and delivery vans (labelled Van), which KITTI-style training ignores for Car.
+  double truck = 0.0, delivery_van = 0.0;
+  QueueConfig queue;
 };
 
 struct SimConfig {
@@ -116,6 +157,9 @@ struct SimConfig {
   ClutterConfig clutter;
   TrafficConfig traffic;
   std::map<std::string, MaterialConfig> materials;  // see defaultMaterials()
+  // Car paint: per car, a mode drawn by weight, then a reflectivity uniformly in its range (spread by the `paint`
+  // material's sigma is not applied). Empty = the `paint` material for every car.
+  std::vector<PaintMode> paint;
 };
 
 // The material table every scene uses (asphalt, marking, concrete, curb, terrain, building, glass, foliage, bark,
