@@ -27,6 +27,7 @@
 #include "ret3d/relation/intra_rm.h"
 #include "ret3d/ros/conversions.h"
 #include "ret3d/ros/kitti_bag.h"
+#include "support/boxes.h"
 #include "support/ros_test_util.h"
 #include "support/test_util.h"
 #include "support/tiny_sequence.h"
