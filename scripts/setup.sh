@@ -49,9 +49,22 @@ fi
 
 if [[ "${1:-}" == "--no-build" ]]; then exit 0; fi
 
+# vision_msgs (objects/detections): the system's when `rospack find vision_msgs` finds one outside this folder (a ROS
+# distribution's package); otherwise third_party/vision_msgs is built with the package (Debian ships none).
+system_vision_msgs=$(ROS_PACKAGE_PATH="${ROS_PACKAGE_PATH:+$ROS_PACKAGE_PATH:}/usr/share" rospack find vision_msgs \
+  2>/dev/null || true)
+if [[ -n "$system_vision_msgs" && "$system_vision_msgs" != "$ROOT"/* ]]; then
+  echo "ret3d setup: vision_msgs from the system ($system_vision_msgs)"
+  bundled_vision_msgs=OFF
+else
+  echo "ret3d setup: no vision_msgs on the system: third_party/vision_msgs is built with the package"
+  bundled_vision_msgs=ON
+fi
+
 echo "ret3d setup: configuring and building into build/ ..."
 cmake -S "$ROOT" -B "$ROOT/build" -DCMAKE_BUILD_TYPE=Release -DPYTHON_EXECUTABLE=/usr/bin/python3 \
-  -DCATKIN_ENABLE_TESTING=ON >"$ROOT/build.log" 2>&1 || { cat "$ROOT/build.log"; exit 1; }
+  -DCATKIN_ENABLE_TESTING=ON -DRET3D_BUNDLED_VISION_MSGS=$bundled_vision_msgs >"$ROOT/build.log" 2>&1 \
+  || { cat "$ROOT/build.log"; exit 1; }
 if ! cmake --build "$ROOT/build" -j"$(nproc)" --target all tests >>"$ROOT/build.log" 2>&1; then
   grep -E "error|Error" -A3 "$ROOT/build.log" | head -60 >&2
   echo "ret3d setup: build failed; the full log is in build.log" >&2

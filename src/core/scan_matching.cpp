@@ -1,7 +1,9 @@
 #include "ret3d/core/scan_matching.h"
 
+#include <array>
 #include <cmath>
 #include <cstdint>
+#include <stdexcept>
 #include <unordered_map>
 #include <vector>
 
@@ -9,10 +11,12 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
-namespace ret3d {
-namespace {
+#include "scan_matching_points.h"
+#include "ret3d/core/enum_names.h"
 
-using Points = std::vector<Eigen::Vector3d>;
+namespace ret3d {
+namespace scan_matching {
+namespace {
 
 // 21 bits per axis; cellOf keeps each index (and its neighbours) within them, so the shifts never overflow.
 std::uint64_t voxelKey(int x, int y, int z) {
@@ -26,6 +30,8 @@ Eigen::Vector3i cellOf(const Eigen::Vector3d& p, double size) {
   auto cell = [size](double v) { return static_cast<int>(std::fmax(-1e6, std::fmin(1e6, std::floor(v / size)))); };
   return {cell(p.x()), cell(p.y()), cell(p.z())};
 }
+
+}  // namespace
 
 // One centroid per voxel of the non-ground points within range.
 Points downsample(const PointCloud& cloud, const ScanMatchingOptions& o) {
@@ -44,6 +50,20 @@ Points downsample(const PointCloud& cloud, const ScanMatchingOptions& o) {
   for (const auto& [key, cell] : cells) out.push_back(cell.first / cell.second);
   return out;
 }
+
+Eigen::Isometry3d planar(double x, double y, double yaw) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  T.translation() = Eigen::Vector3d(x, y, 0);
+  return T;
+}
+
+Eigen::Isometry3d planarPart(const Eigen::Isometry3d& T) {
+  const Eigen::Matrix3d R = T.linear();
+  return planar(T.translation().x(), T.translation().y(), std::atan2(R(1, 0), R(0, 0)));
+}
+
+namespace {
 
 // Points hashed by cells as large as the search radius, so a neighbour lies in the 27 cells around the query.
 class VoxelHash {
@@ -111,25 +131,17 @@ std::vector<Eigen::Vector3d> normals(const Points& points, double radius) {
   return out;
 }
 
-Eigen::Isometry3d planar(double x, double y, double yaw) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  T.translation() = Eigen::Vector3d(x, y, 0);
-  return T;
-}
-
 }  // namespace
 
-ScanMatch matchScans(const PointCloud& source, const PointCloud& target, const Eigen::Isometry3d& initial,
-                     const ScanMatchingOptions& o) {
+ScanMatch matchIcp(const PointCloud& source, const PointCloud& target, const Eigen::Isometry3d& initial,
+                   const ScanMatchingOptions& o) {
   const Points src = downsample(source, o), dst = downsample(target, o);
   // Point-to-plane (Chen & Medioni 1992): points may slide along walls, so a street seen from two places along it
   // does not pull the motion towards zero as point-to-point does.
   const std::vector<Eigen::Vector3d> dst_normals = normals(dst, 2.5 * o.voxel_size);
   ScanMatch result;
   // Start from the initial guess projected on the ground plane.
-  const Eigen::Matrix3d R0 = initial.linear();
-  Eigen::Isometry3d T = planar(initial.translation().x(), initial.translation().y(), std::atan2(R0(1, 0), R0(0, 0)));
+  Eigen::Isometry3d T = planarPart(initial);
   for (int stage = 0; stage < o.stages; ++stage) {
     const double radius = o.stages > 1 ? o.first_distance * std::pow(o.last_distance / o.first_distance,
                                                                       static_cast<double>(stage) / (o.stages - 1))
@@ -167,6 +179,27 @@ ScanMatch matchScans(const PointCloud& source, const PointCloud& target, const E
   result.converged = result.correspondences >= o.min_correspondences;
   result.source_to_target = T;
   return result;
+}
+
+}  // namespace scan_matching
+
+namespace {
+constexpr std::array<const char*, 2> kScanMatcherNames = {"icp", "gicp"};
+static_assert(kScanMatcherNames.size() == static_cast<std::size_t>(ScanMatcher::Gicp) + 1);
+}  // namespace
+
+const char* scanMatcherName(ScanMatcher matcher) { return enumName(matcher, kScanMatcherNames); }
+
+ScanMatcher parseScanMatcher(const std::string& name) {
+  for (std::size_t i = 0; i < kScanMatcherNames.size(); ++i)
+    if (name == kScanMatcherNames[i]) return static_cast<ScanMatcher>(i);
+  throw std::invalid_argument("unknown scan matcher '" + name + "' (icp or gicp)");
+}
+
+ScanMatch matchScans(const PointCloud& source, const PointCloud& target, const Eigen::Isometry3d& initial,
+                     const ScanMatchingOptions& options) {
+  return options.matcher == ScanMatcher::Gicp ? scan_matching::matchGicp(source, target, initial, options)
+                                              : scan_matching::matchIcp(source, target, initial, options);
 }
 
 }  // namespace ret3d

@@ -6,7 +6,9 @@
 // tracker nodelet's parameters, src/ros/params.cpp). Boxes without a track id pass through unrefined; so does the
 // whole frame if the module refuses it (throttled warning). With ~passthrough (launch inter:=false) no model is loaded
 // and every frame is published unrefined: the stage is off but `objects` still comes out (a remap cannot bridge
-// `tracked` to `objects`, their message types differ).
+// `tracked` to `objects`, their message types differ). The same objects also go out as vision_msgs/Detection3DArray
+// on objects/detections (ros/detection3d.h: class id, score, box; same stamp and frame) unless ~publish_detections is
+// false; converted only while someone subscribes.
 #include <pluginlib/class_list_macros.hpp>
 
 #include <algorithm>
@@ -16,6 +18,7 @@
 #include "ret3d/pipeline/track_histories.h"
 #include "ret3d/relation/inter_rm.h"
 #include "ret3d/ros/conversions.h"
+#include "ret3d/ros/detection3d.h"
 #include "ret3d/ros/nodelets.h"
 
 namespace ret3d {
@@ -38,6 +41,8 @@ class InterRMNodelet : public StageNodelet<ret3d::DetectionArray> {
     }
     poses_ = std::make_unique<PoseSource>(params_.pose, getNodeHandle());
     publisher_ = getNodeHandle().advertise<ret3d::Object3DArray>("objects", 1);
+    if (params_.publish_detections)
+      detections_publisher_ = getNodeHandle().advertise<vision_msgs::Detection3DArray>("objects/detections", 1);
     start("tracked");
   }
 
@@ -64,7 +69,12 @@ class InterRMNodelet : public StageNodelet<ret3d::DetectionArray> {
         }
       }
     }
-    publisher_.publish(ret3d::Object3DArrayPtr(new ret3d::Object3DArray(toMsg(boxes, msg->header))));
+    const ret3d::Object3DArrayPtr objects(new ret3d::Object3DArray(toMsg(boxes, msg->header)));
+    publisher_.publish(objects);
+    if (detections_publisher_ && detections_publisher_.getNumSubscribers() > 0) {
+      detections_publisher_.publish(
+          vision_msgs::Detection3DArrayPtr(new vision_msgs::Detection3DArray(toDetection3DArray(*objects))));
+    }
   }
 
   static std::vector<Box> fromMsgs(const ret3d::DetectionArray& msg) {
@@ -78,7 +88,7 @@ class InterRMNodelet : public StageNodelet<ret3d::DetectionArray> {
   std::unique_ptr<relation::InterRM> inter_;
   std::unique_ptr<pipeline::TrackHistories> histories_;
   std::unique_ptr<PoseSource> poses_;
-  ros::Publisher publisher_;
+  ros::Publisher publisher_, detections_publisher_;
 };
 
 }  // namespace ret3d

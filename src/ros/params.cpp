@@ -272,6 +272,7 @@ InterRMNodeletParams loadInterRMNodeletParams(const ros::NodeHandle& private_nh)
   const ParamReader p(private_nh);
   InterRMNodeletParams params;
   params.passthrough = p.boolean("passthrough", false);
+  params.publish_detections = p.boolean("publish_detections", true);
   params.inter.model_path = p.nonEmpty("model_path", defaultModelPath("inter_rm.pt"));
   params.inter.threads = p.integer("threads", 2, 1, 64);
   params.pose = loadPoseParams(p);

@@ -4,14 +4,19 @@
 // Checks: an output on every topic for every input frame, stamps and frame ids kept, track ids stable, markers as
 // documented (DELETEALL first, class colours, labels, arrows, trails); the pipeline keeps going and says so when the
 // transform is missing or stamps go backwards; a nodelet with an invalid parameter or a missing/corrupt model file
-// refuses to start with a message naming the parameter, its value and what is wrong.
+// refuses to start with a message naming the parameter, its value and what is wrong. The objects also come out as
+// vision_msgs/Detection3DArray (objects/detections) matching /objects frame by frame, with upstream vision_msgs'
+// type and md5 as `rostopic type` and `rosmsg md5` see them; ~publish_detections false leaves the topic out.
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <tf2_msgs/TFMessage.h>
+#include <vision_msgs/Detection3DArray.h>
 #include <visualization_msgs/MarkerArray.h>
 
+#include <cctype>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <mutex>
@@ -22,9 +27,11 @@
 #include "ret3d/relation/intra_rm.h"
 #include "ret3d/ros/conversions.h"
 #include "ret3d/ros/kitti_bag.h"
+#include "support/boxes.h"
 #include "support/ros_test_util.h"
 #include "support/test_util.h"
 #include "support/tiny_sequence.h"
+#include "support/vision_msgs_upstream.h"
 
 namespace ret3d {
 namespace {
@@ -108,6 +115,7 @@ class PipelineChain : public ::testing::Test {
     tracked_.listen(nh_, "/tracked");
     objects_.listen(nh_, "/objects");
     markers_.listen(nh_, "/objects/markers");
+    detections_.listen(nh_, "/objects/detections");
     detections_pub_ = nh_.advertise<ret3d::DetectionArray>("/detections", 10);
     tf_pub_ = nh_.advertise<tf2_msgs::TFMessage>("/tf", 100);
     tf_static_pub_ = nh_.advertise<tf2_msgs::TFMessage>("/tf_static", 10, /*latch=*/true);
@@ -145,6 +153,7 @@ class PipelineChain : public ::testing::Test {
   test::Inbox<ret3d::DetectionArray> intra_, tracked_;
   test::Inbox<ret3d::Object3DArray> objects_;
   test::Inbox<visualization_msgs::MarkerArray> markers_;
+  test::Inbox<vision_msgs::Detection3DArray> detections_;
 };
 
 TEST_F(PipelineChain, EveryFrameThroughEveryStageWithStableIds) {
@@ -243,6 +252,72 @@ TEST_F(PipelineChain, MissingTransformAndBackwardsStampsKeepItRunning) {
   EXPECT_EQ(objects_.all().back()->header.stamp, frames_.objects[2]->header.stamp);
   EXPECT_FALSE(log_.find({"tracker reset"}).empty()) << log_.all();
   EXPECT_FALSE(log_.find({"stamp went backwards", "histories cleared"}).empty()) << log_.all();
+}
+
+// What a ROS command line tool prints (stdout and stderr), trimmed; empty when it failed.
+std::string toolOutput(const std::vector<std::string>& args, const std::string& log) {
+  std::filesystem::remove(log);  // the child appends to it
+  if (test::runLogged(args, log, 20.0) != 0) return "";
+  std::string out = test::readText(log);
+  while (!out.empty() && std::isspace(static_cast<unsigned char>(out.back()))) out.pop_back();
+  return out;
+}
+
+TEST_F(PipelineChain, ObjectsAlsoComeAsVisionMsgsDetections) {
+  ros::AsyncSpinner spinner(2);
+  spinner.start();
+  nodelet::Loader loader(false);
+  startPipeline(loader);
+  auto& detections = detections_;
+  ASSERT_TRUE(test::waitFor([&] { return detections.sub.getNumPublishers() > 0; }, 10.0));
+  for (int f = 0; f < kFrames; ++f) {
+    ASSERT_TRUE(playFrame(asDetections(*frames_.objects[f]))) << "frame " << f << "\n" << log_.all();
+  }
+  ASSERT_TRUE(test::waitFor([&] { return detections.size() == kFrames; }, 5.0)) << detections.size();
+  // Every Detection3D matches the object of the Object3DArray with the same stamp: class, score, box.
+  std::map<ros::Time, ret3d::Object3DArray::ConstPtr> objects;
+  for (const auto& o : objects_.all()) objects[o->header.stamp] = o;
+  for (const auto& d : detections.all()) {
+    ASSERT_EQ(objects.count(d->header.stamp), 1u) << "no /objects at " << d->header.stamp;
+    const ret3d::Object3DArray& o = *objects[d->header.stamp];
+    EXPECT_EQ(d->header.frame_id, o.header.frame_id);
+    ASSERT_EQ(d->detections.size(), o.objects.size());
+    ASSERT_EQ(d->detections.size(), 2u);
+    for (std::size_t i = 0; i < o.objects.size(); ++i) {
+      const vision_msgs::Detection3D& det = d->detections[i];
+      const Box want = fromMsg(o.objects[i]);
+      EXPECT_EQ(det.header.stamp, o.header.stamp);
+      ASSERT_EQ(det.results.size(), 1u);
+      EXPECT_EQ(det.results[0].id, static_cast<int>(want.label));  // 1 Car, 2 Pedestrian, 3 Cyclist
+      EXPECT_DOUBLE_EQ(det.results[0].score, want.score);
+      ret3d::Object3D as_object;  // the detection's box read back as a Box
+      as_object.pose = det.bbox.center;
+      as_object.dimensions = det.bbox.size;
+      const Box got = fromMsg(as_object);
+      test::expectSameCentreAndSize(got, want, 1e-9);
+      EXPECT_NEAR(got.yaw, want.yaw, 1e-9);
+    }
+  }
+  // On the graph: upstream vision_msgs' type and md5, as the ROS tools report them.
+  EXPECT_EQ(toolOutput({"rostopic", "type", "/objects/detections"}, tmp_ / "rostopic.log"),
+            "vision_msgs/Detection3DArray");
+  for (const auto& [type, md5] : test::upstreamVisionMsgsMd5()) {
+    EXPECT_EQ(toolOutput({"rosmsg", "md5", type}, tmp_ / "rosmsg.log"), md5) << type;
+  }
+  EXPECT_EQ(ros::message_traits::MD5Sum<vision_msgs::Detection3DArray>::value(),
+            test::upstreamVisionMsgsMd5().front().second);
+}
+
+TEST_F(PipelineChain, NoDetectionsTopicWhenSwitchedOff) {
+  ros::param::set("/ret3d_inter/publish_detections", false);
+  ros::AsyncSpinner spinner(2);
+  spinner.start();
+  nodelet::Loader loader(false);
+  startPipeline(loader);
+  for (int f = 0; f < 3; ++f) ASSERT_TRUE(playFrame(asDetections(*frames_.objects[f]))) << "frame " << f;
+  ASSERT_TRUE(test::waitFor([&] { return objects_.size() == 3u; }, 5.0));
+  EXPECT_EQ(detections_.sub.getNumPublishers(), 0u);
+  EXPECT_EQ(detections_.size(), 0u);
 }
 
 // A nodelet that cannot run as configured refuses to start and says why.

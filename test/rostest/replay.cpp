@@ -2,14 +2,19 @@
 // it to a bag with the project's converter, saves real (untrained) model files with the stages' own save functions,
 // then runs the real `roslaunch ret3d replay.launch bag:=... record:=...` (all five nodelets in one manager, rosbag
 // play --clock with use_sim_time, rosbag record) as a child process and checks the recorded bag: an /objects message
-// for every input cloud (drops at most 1 %), stamps and frame ids kept, the ground truth recorded beside it. Accuracy
+// for every input cloud (drops at most 1 %), stamps and frame ids kept, the ground truth recorded beside it, and an
+// /objects/detections message (upstream vision_msgs' type and md5) beside each /objects with as many detections. Accuracy
 // (mAP, id stability against the ground truth) with the trained default models on a simulated drive:
 // test/rostest/replay_accuracy.cpp.
 #include <gtest/gtest.h>
 #include <ros/ros.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <vision_msgs/Detection3DArray.h>
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -19,6 +24,7 @@
 #include "support/test_util.h"
 #include "support/tiny_models.h"
 #include "support/tiny_sequence.h"
+#include "support/vision_msgs_upstream.h"
 
 namespace ret3d {
 namespace {
@@ -69,6 +75,24 @@ TEST(Replay, EveryCloudGivesObjectsInTheRecordedBag) {
   std::set<double> in_stamps;
   for (const auto& t : truth) in_stamps.insert(t.stamp);
   for (double s : out_stamps) EXPECT_EQ(in_stamps.count(s), 1u) << "output stamp " << s << " is no input's";
+
+  // The same objects as vision_msgs/Detection3DArray, recorded with upstream's type and md5.
+  std::map<double, std::size_t> objects_at;
+  for (const auto& o : objects) objects_at[o.stamp] = o.boxes.size();
+  rosbag::Bag recorded(out, rosbag::bagmode::Read);
+  rosbag::View view(recorded, rosbag::TopicQuery("/objects/detections"));
+  ASSERT_EQ(view.size(), objects.size()) << launch_log;
+  for (const rosbag::ConnectionInfo* c : view.getConnections()) {
+    EXPECT_EQ(c->datatype, "vision_msgs/Detection3DArray");
+    EXPECT_EQ(c->md5sum, test::upstreamVisionMsgsMd5().front().second);
+  }
+  for (const rosbag::MessageInstance& m : view) {
+    const vision_msgs::Detection3DArray::ConstPtr d = m.instantiate<vision_msgs::Detection3DArray>();
+    ASSERT_NE(d, nullptr);
+    EXPECT_EQ(d->header.frame_id, "velodyne");
+    ASSERT_EQ(objects_at.count(d->header.stamp.toSec()), 1u) << "no /objects at " << d->header.stamp;
+    EXPECT_EQ(d->detections.size(), objects_at[d->header.stamp.toSec()]);
+  }
 }
 
 }  // namespace

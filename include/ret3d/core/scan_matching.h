@@ -1,16 +1,25 @@
-// Ego motion between two consecutive LiDAR scans without poses: a small point-to-plane ICP on
-// voxel-downsampled non-ground points, with a voxel hash for the nearest neighbours. The motion is estimated in the
+// Ego motion between two consecutive LiDAR scans without poses, from voxel-downsampled non-ground points, in the
 // ground plane (x, y, yaw): the ground is left out (it constrains only z, roll and pitch), and road vehicles move in
-// that plane. Used by `ret3d autolabel` for scan folders that come without poses.
+// that plane. Two registrations (ScanMatcher): a small point-to-plane ICP written here, with a voxel hash for the
+// nearest neighbours, and PCL's generalized ICP on the same points. Used by `ret3d autolabel` for scan folders that
+// come without poses; `ret3d egomotion` measures both (docs/RESULTS.md, "Ego motion from the scans").
 #pragma once
 
 #include <Eigen/Geometry>
+
+#include <string>
 
 #include "ret3d/core/types.h"
 
 namespace ret3d {
 
+enum class ScanMatcher {
+  Icp,   // point-to-plane ICP in (x, y, yaw), coarse to fine (the stages below)
+  Gicp,  // PCL's pcl::GeneralizedIterativeClosestPoint (plane-to-plane), 6 DoF, projected on the ground plane
+};
+
 struct ScanMatchingOptions {
+  ScanMatcher matcher = ScanMatcher::Icp;
   double voxel_size = 0.4;      // m: both scans are reduced to one centroid per voxel
   double ground_height = -1.3;  // m in the sensor frame: points below are ground (KITTI's sensor is 1.73 m up)
   double max_range = 50.0;      // m (BEV): farther points are sparse and noisy
@@ -18,6 +27,10 @@ struct ScanMatchingOptions {
   double first_distance = 2.0, last_distance = 0.5;
   int stages = 3, iterations = 15;
   int min_correspondences = 50;  // fewer: the match failed
+  // Gicp: correspondence distance (m) and iterations; converged as PCL says, with min_correspondences source points
+  // within last_distance of the target after the match.
+  double gicp_distance = 1.0;
+  int gicp_iterations = 50;
 };
 
 struct ScanMatch {
@@ -32,5 +45,9 @@ struct ScanMatch {
 ScanMatch matchScans(const PointCloud& source, const PointCloud& target,
                      const Eigen::Isometry3d& initial = Eigen::Isometry3d::Identity(),
                      const ScanMatchingOptions& options = {});
+
+// "icp" / "gicp" <-> ScanMatcher; parseScanMatcher throws std::invalid_argument naming the accepted values.
+ScanMatcher parseScanMatcher(const std::string& name);
+const char* scanMatcherName(ScanMatcher matcher);
 
 }  // namespace ret3d

@@ -96,6 +96,8 @@ struct TrackerNodeletParams {
 struct InterRMNodeletParams {
   relation::InterRMOptions inter;    // ~model_path, ~threads
   bool passthrough = false;          // ~passthrough: no model, tracked boxes published unrefined (stage off)
+  // ~publish_detections: the objects also as vision_msgs/Detection3DArray on objects/detections (ros/detection3d.h)
+  bool publish_detections = true;
   PoseParams pose;
   // Histories of track ids not seen for more than this many frames are dropped: the tracker's max_age, read from the
   // tracker nodelet's own parameters (~tracker_node, default "ret3d_tracker", a sibling of this nodelet), since a
