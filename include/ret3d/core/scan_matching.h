@@ -1,7 +1,7 @@
 // Ego motion between two consecutive LiDAR scans without poses: a small point-to-plane ICP on
 // voxel-downsampled non-ground points, with a voxel hash for the nearest neighbours. The motion is estimated in the
 // ground plane (x, y, yaw): the ground is left out (it constrains only z, roll and pitch), and road vehicles move in
-// that plane. Used by `ret3d autolabel` for scan folders that come without poses.
+// that plane. Used by io/ego_motion.h (`ret3d autolabel`, `ret3d detect`) for scan folders that come without poses.
 #pragma once
 
 #include <Eigen/Geometry>
