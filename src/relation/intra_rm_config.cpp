@@ -42,8 +42,8 @@ template <class ConfigIO>
 void visitConfig(ConfigIO& io, IntraRMConfig* c) {
   IntraRMArch& m = c->model;
   io.section("model", "feature_dim", &m.feature_dim, "hidden", &m.hidden, "rounds", &m.rounds, "radius", &m.radius,
-             "use_edges", &m.use_edges, "head_hidden", &m.head_hidden, "refine_boxes", &m.refine_boxes, "score_scale", &m.score_scale,
-             "score_bias", &m.score_bias);
+             "use_edges", &m.use_edges, "head_hidden", &m.head_hidden, "refine_boxes", &m.refine_boxes, "score_scale",
+             &m.score_scale, "score_bias", &m.score_bias);
   IntraRMTrainConfig& t = c->train;
   io.section("train", "lr", &t.lr, "weight_decay", &t.weight_decay, "frames_per_batch", &t.frames_per_batch,
              "epochs", &t.epochs, "loc_weight", &t.loc_weight, "dir_weight", &t.dir_weight, "focal_alpha",

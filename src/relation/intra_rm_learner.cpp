@@ -10,6 +10,7 @@
 #include "intra_rm_network.h"
 #include "learner_checkpoint.h"
 #include "ret3d/core/geometry.h"
+#include "ret3d/core/log.h"
 
 namespace ret3d {
 namespace relation {
@@ -259,9 +260,11 @@ PerClass<std::size_t> calibrateIntraRMScores(IntraRM* model, const std::vector<I
       continue;
     }
     const auto [a, b] = fitPlatt(z[c], t[c]);
-    if (!(a > 0) || !std::isfinite(b)) throw std::runtime_error("IntraRM score calibration: no increasing fit for " +
-                                                                std::string(className(kDetectedClasses[c])));
-    arch.score_scale[c] = a, arch.score_bias[c] = b;
+    const bool increasing = a > 0 && std::isfinite(a) && std::isfinite(b);
+    if (!increasing)  // a network whose scores do not rank this class: its scores are left as they are
+      RET3D_WARN("IntraRM score calibration: " << className(kDetectedClasses[c]) << "'s scores do not rise with its "
+                                               << "true positives (slope " << a << "); left uncalibrated");
+    arch.score_scale[c] = increasing ? a : 1.0, arch.score_bias[c] = increasing ? b : 0.0;
   }
   arch.validate();
   return used;

@@ -6,10 +6,11 @@
 //                --intra-model models/kitti_pointrcnn/intra_rm.pt --data ../shared/data/kitti_tracking
 //                --sequences 16-20 --out out/pred_intra
 // With the `base` stage the boxes come from the LWD-3D detector on the folder's scans (the previous sweep moved by
-// the ego motion of --poses, pose/ or oxts/, or else estimated from the scans by scan matching); without it they come from another detector's result files (--detections:
-// KITTI object/tracking result files or the per-class CSV layout). `--stages` lists what runs, in order:
-// base, intra (IntraRM), track (the CenterPoint-style tracker, in the fixed frame of the ego poses), inter (tracker + InterRM), or none
-// (the boxes pass through the same conversions: the fair baseline).
+// the ego motion of --poses, pose/ or oxts/, or else estimated from the scans by scan matching); without it they come
+// from another detector's result files (--detections: KITTI object/tracking result files or the per-class CSV layout).
+// `--stages` lists what runs, in order: base, intra (IntraRM), track (the CenterPoint-style tracker, in the fixed
+// frame of the ego poses), inter (tracker + InterRM), or none (the boxes pass through the same conversions: the fair
+// baseline).
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -52,7 +53,8 @@ std::vector<Eigen::Isometry3d> egoPoses(const DetectArgs& a, const kitti::Tracki
                              "them from); give --poses FILE");
   if (!poses.empty() && last_frame >= static_cast<int>(poses.size()))
     throw std::runtime_error("sequence " + seq + ": frame " + std::to_string(last_frame) + " beyond its " +
-                             std::to_string(poses.size()) + " ego poses" + (a.poses.empty() ? "" : " (" + a.poses + ")"));
+                             std::to_string(poses.size()) + " ego poses" +
+                             (a.poses.empty() ? "" : " (" + a.poses + ")"));
   return poses;
 }
 

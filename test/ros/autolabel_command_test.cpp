@@ -50,7 +50,8 @@ class AutolabelCommand : public ::testing::Test {
         RET3D_CLI, command_name, "--data", data, "--out", out, "--models", tmp_ / "models", "--detector-config",
         tmp_ / "models/detector.yaml", "--threads", "1", "--score-threshold", "0", "--tracker-config",
         tmp_ / "tracker.yaml"};
-    if (command_name == "autolabel") command.insert(command.end(), {"--min-track-length", "1", "--min-track-score", "0"});
+    if (command_name == "autolabel")
+      command.insert(command.end(), {"--min-track-length", "1", "--min-track-score", "0"});
     command.insert(command.end(), extra.begin(), extra.end());
     const std::string log = out + ".log";
     const int code = test::runLogged(command, log, 120.0);

@@ -52,8 +52,8 @@ struct EvalReport {
 std::map<std::string, double> metricsMap(const EvalReport& report);
 // The short table printed on stdout: moderate KITTI AP (3D/BEV R40), Waymo L1/L2 APH, MOTA/HOTA.
 std::string headlineTable(const EvalReport& report);
-// Writes DIR/metrics.json, DIR/report.md, DIR/label_returns.csv (with --min-points) and DIR/plots/*.png (plots skipped, with a warning, when gnuplot is
-// missing). Creates DIR. Returns the PNG files written.
+// Writes DIR/metrics.json, DIR/report.md, DIR/label_returns.csv (with --min-points) and DIR/plots/*.png (plots
+// skipped, with a warning, when gnuplot is missing). Creates DIR. Returns the PNG files written.
 std::vector<std::string> writeReport(const std::string& dir, const EvalReport& report);
 
 // Runs `gnuplot script` as a subprocess (no shell); true on success.
