@@ -1,6 +1,7 @@
 #include "ret3d/eval/eval_data.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <map>
 #include <set>
@@ -27,7 +28,10 @@ bool sameType(const std::string& a, const char* b) { return strcasecmp(a.c_str()
 void fillGtBoxesFromLabels(EvalFrame& frame, const kitti::Calibration& calib) {
   frame.gt_boxes.clear();
   frame.gt_ignore.clear();
-  for (const auto& l : frame.gt_labels) {
+  frame.gt_box_label.clear();
+  frame.gt_returns.clear();
+  for (std::size_t i = 0; i < frame.gt_labels.size(); ++i) {
+    const kitti::Label& l = frame.gt_labels[i];
     std::optional<ObjectClass> cls = classFromName(l.type);
     bool ignore = false;
     if (!cls && sameType(l.type, "Van")) {
@@ -42,7 +46,8 @@ void fillGtBoxesFromLabels(EvalFrame& frame, const kitti::Calibration& calib) {
     b.label = *cls;
     b.score = 1.0f;
     frame.gt_boxes.push_back(b);
-    frame.gt_ignore.push_back(ignore);
+    frame.gt_ignore.push_back(ignore || (i < frame.gt_label_ignore.size() && frame.gt_label_ignore[i]));
+    frame.gt_box_label.push_back(static_cast<int>(i));
   }
 }
 
@@ -104,6 +109,74 @@ std::size_t countGroundTruthPoints(EvalData& data, int threads,
   });
   if (!todo.empty()) data.gt_has_point_counts = true;
   return todo.size();
+}
+
+namespace {
+
+// The frame's returns in each ground-truth box grown by kLabelReturnMargin (far_cars.py's returns_in_label).
+void countLabelReturns(EvalFrame& f) {
+  std::vector<Box> grown = f.gt_boxes;
+  for (Box& b : grown) {
+    b.length += 2 * kLabelReturnMargin;
+    b.width += 2 * kLabelReturnMargin;
+    b.height += 2 * kLabelReturnMargin;
+  }
+  f.gt_returns = countPointsInBoxes(grown, kitti::readVelodyne(f.velodyne_path));
+}
+
+std::string frameName(const EvalFrame& f) {
+  return (f.sequence.empty() ? "" : "sequence " + f.sequence + " ") + "frame " + std::to_string(f.frame);
+}
+
+}  // namespace
+
+std::map<ObjectClass, MinPointsCounts> ignoreLabelsWithFewReturns(
+    EvalData& data, int min_points, int threads, const std::function<void(std::size_t, std::size_t)>& progress) {
+  if (min_points < 0) throw std::invalid_argument("--min-points: " + std::to_string(min_points) + " is negative");
+  std::vector<std::size_t> todo;
+  for (std::size_t i = 0; i < data.frames.size(); ++i) {
+    const EvalFrame& f = data.frames[i];
+    if (f.gt_boxes.empty()) continue;
+    if (f.gt_box_label.size() != f.gt_boxes.size())
+      throw std::invalid_argument("--min-points: the ground truth of " + frameName(f) +
+                                  " is not from KITTI labels (a bag?); it needs a KITTI folder with the scans");
+    if (f.velodyne_path.empty())
+      throw std::runtime_error("--min-points: no scan for " + frameName(f) +
+                               " (velodyne/ beside the labels): returns in the labels are counted from it");
+    todo.push_back(i);
+  }
+  detail::ProgressCounter counter(progress, todo.size());
+  detail::parallelFor(todo.size(), threads, [&](std::size_t k) {
+    countLabelReturns(data.frames[todo[k]]);
+    counter.tick();
+  });
+  std::map<ObjectClass, MinPointsCounts> counts;
+  for (std::size_t i : todo) {
+    EvalFrame& f = data.frames[i];
+    f.gt_label_ignore.assign(f.gt_labels.size(), 0);
+    for (std::size_t b = 0; b < f.gt_boxes.size(); ++b) {
+      const bool few = f.gt_returns[b] < static_cast<std::uint32_t>(min_points);
+      if (few) f.gt_label_ignore[static_cast<std::size_t>(f.gt_box_label[b])] = 1;
+      if (!classFromName(f.gt_labels[static_cast<std::size_t>(f.gt_box_label[b])].type)) continue;  // Van, ...
+      MinPointsCounts& c = counts[f.gt_boxes[b].label];
+      ++(few ? c.ignored : c.kept);
+      if (few) f.gt_ignore[b] = 1;
+    }
+  }
+  return counts;
+}
+
+std::vector<LabelReturns> labelReturns(const EvalData& data) {
+  std::vector<LabelReturns> out;
+  for (const EvalFrame& f : data.frames) {
+    for (std::size_t b = 0; b < f.gt_returns.size() && b < f.gt_boxes.size(); ++b) {
+      const Box& box = f.gt_boxes[b];
+      const kitti::Label& l = f.gt_labels[static_cast<std::size_t>(f.gt_box_label[b])];
+      out.push_back({f.sequence, f.frame, f.gt_box_label[b], l.type, l.track_id, std::hypot(box.x, box.y),
+                     f.gt_returns[b], f.gt_ignore[b] != 0});
+    }
+  }
+  return out;
 }
 
 std::vector<std::string> parseSequenceList(const std::string& text) {

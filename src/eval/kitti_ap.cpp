@@ -164,7 +164,8 @@ int cleanData(const KittiFrame& f, ObjectClass cls, int diff, std::vector<int>& 
   int n_gt = 0;
   ignored_gt.clear();
   ignored_det.clear();
-  for (const auto& g : f.gt) {
+  for (std::size_t i = 0; i < f.gt.size(); ++i) {
+    const kitti::Label& g = f.gt[i];
     const double height = g.bbox[3] - g.bbox[1];
     int valid_class;
     if (sameType(g.type, name)) {
@@ -177,7 +178,7 @@ int cleanData(const KittiFrame& f, ObjectClass cls, int diff, std::vector<int>& 
       valid_class = -1;
     }
     const bool ignore = g.occluded > kKittiMaxOcclusion[diff] || g.truncated > kKittiMaxTruncation[diff] ||
-                        height < kKittiMinHeight[diff];
+                        height < kKittiMinHeight[diff] || (i < f.gt_ignore.size() && f.gt_ignore[i]);
     if (valid_class == 1 && !ignore) {
       ignored_gt.push_back(0);
       ++n_gt;

@@ -117,6 +117,13 @@ std::map<std::string, double> metricsMap(const EvalReport& r) {
   m["count.frames"] = static_cast<double>(r.num_frames);
   m["count.gt"] = static_cast<double>(r.num_gt);
   m["count.pred"] = static_cast<double>(r.num_pred);
+  if (r.min_points > 0) {
+    m["min_points.threshold"] = r.min_points;
+    for (const auto& [cls, c] : r.min_points_counts) {
+      m[std::string("min_points.") + className(cls) + ".kept"] = static_cast<double>(c.kept);
+      m[std::string("min_points.") + className(cls) + ".ignored"] = static_cast<double>(c.ignored);
+    }
+  }
   if (r.kitti) {
     addKitti(m, "kitti", *r.kitti);
     for (const auto& c : r.kitti->classes) {
@@ -367,6 +374,28 @@ void reportInputs(std::ostringstream& md, const EvalReport& r) {
   }
 }
 
+void reportMinPoints(std::ostringstream& md, const EvalReport& r) {
+  md << "## Labels holding few returns (--min-points " << r.min_points << ")\n\n"
+     << "Returns of a label: the points of its frame's scan inside its box grown by " << fmt(kLabelReturnMargin)
+     << " m on every side. A label holding fewer than " << r.min_points
+     << " is ignored by every metric, as the Waymo Open Dataset leaves out objects without enough returns: not a miss "
+        "when unmatched, and a prediction matched to it neither a true nor a false positive. Every label's count: "
+        "label_returns.csv.\n\n"
+     << "| class | labels kept | labels ignored |\n| --- | ---: | ---: |\n";
+  for (const auto& [cls, c] : r.min_points_counts)
+    md << "| " << className(cls) << " | " << c.kept << " | " << c.ignored << " |\n";
+  md << "\n";
+}
+
+std::string labelReturnsCsv(const std::vector<LabelReturns>& labels) {
+  std::ostringstream csv;
+  csv << "sequence,frame,label,type,track_id,range_m,returns,ignored\n";
+  for (const LabelReturns& l : labels)
+    csv << l.sequence << "," << l.frame << "," << l.label << "," << l.type << "," << l.track_id << "," << fmt(l.range)
+        << "," << l.returns << "," << (l.ignored ? 1 : 0) << "\n";
+  return csv.str();
+}
+
 void reportKitti(std::ostringstream& md, const EvalReport& r, const std::vector<std::string>& pngs) {
   md << "## KITTI object detection AP (official devkit rules)\n\n"
      << "Computed as the KITTI object devkit (evaluate_object_3d_offline, with the 2017 minimum-height fix) in "
@@ -507,8 +536,11 @@ std::vector<std::string> writeReport(const std::string& dir, const EvalReport& r
   if (r.kitti) plotKitti(r, &plots);
   if (r.waymo) plotWaymo(r, &plots);
 
+  if (r.min_points > 0) writeFile(pathJoin(dir, "label_returns.csv"), labelReturnsCsv(r.label_returns));
+
   std::ostringstream md;
   reportInputs(md, r);
+  if (r.min_points > 0) reportMinPoints(md, r);
   if (r.kitti) reportKitti(md, r, plots.pngs());
   if (r.waymo) reportWaymo(md, r, plots.pngs());
   if (r.mot) reportMot(md, r);

@@ -54,7 +54,7 @@ Detections IntraRM::refine(const Detections& input) const {
   torch::InferenceMode guard;
   const IntraRMInputs in = makeIntraRMInputs({src}, a);
   const IntraRMOutput out = impl_->net->forward(in.basic, in.feat, in.source, in.target);
-  return applyIntraRMOutput(input, out, a.refine_boxes);
+  return applyIntraRMOutput(input, out, a);
 }
 
 }  // namespace relation

@@ -15,6 +15,11 @@ void IntraRMArch::validate() const {
   if (!std::isfinite(radius) || radius < 0)
     throw std::invalid_argument("IntraRM model.radius must be a finite value >= 0 (metres)");
   if (feature_dim > 100000) throw std::invalid_argument("IntraRM model.feature_dim is implausibly large");
+  for (std::size_t k = 0; k < 3; ++k) {
+    if (!std::isfinite(score_scale[k]) || score_scale[k] <= 0)
+      throw std::invalid_argument("IntraRM model.score_scale must be finite and > 0 (a monotone calibration)");
+    if (!std::isfinite(score_bias[k])) throw std::invalid_argument("IntraRM model.score_bias must be finite");
+  }
 }
 
 void IntraRMTrainConfig::validate() const {
@@ -37,7 +42,8 @@ template <class ConfigIO>
 void visitConfig(ConfigIO& io, IntraRMConfig* c) {
   IntraRMArch& m = c->model;
   io.section("model", "feature_dim", &m.feature_dim, "hidden", &m.hidden, "rounds", &m.rounds, "radius", &m.radius,
-             "use_edges", &m.use_edges, "head_hidden", &m.head_hidden, "refine_boxes", &m.refine_boxes);
+             "use_edges", &m.use_edges, "head_hidden", &m.head_hidden, "refine_boxes", &m.refine_boxes, "score_scale",
+             &m.score_scale, "score_bias", &m.score_bias);
   IntraRMTrainConfig& t = c->train;
   io.section("train", "lr", &t.lr, "weight_decay", &t.weight_decay, "frames_per_batch", &t.frames_per_batch,
              "epochs", &t.epochs, "loc_weight", &t.loc_weight, "dir_weight", &t.dir_weight, "focal_alpha",

@@ -1,13 +1,16 @@
 // Training IntraRM: Ret3D eq. (5) and AdamW (the paper's optimiser, lr 3e-4, weight decay 0.01).
 #include "ret3d/relation/intra_rm_learner.h"
 
+#include <array>
 #include <cmath>
+#include <numeric>
 #include <random>
 #include <stdexcept>
 
 #include "intra_rm_network.h"
 #include "learner_checkpoint.h"
 #include "ret3d/core/geometry.h"
+#include "ret3d/core/log.h"
 
 namespace ret3d {
 namespace relation {
@@ -193,6 +196,79 @@ IntraRMLoss meanLoss(Learner& learner, const std::vector<IntraRMFrame>& frames) 
 }
 
 template class RelationLearner<IntraRM, IntraRMFrame, IntraRMLoss>;
+
+namespace {
+
+// Logistic regression p = sigmoid(a z + b) of targets t on logits z by Newton's method (a tiny ridge keeps the
+// Hessian invertible); halves a step that does not lower the loss.
+std::pair<double, double> fitPlatt(const std::vector<double>& z, const std::vector<double>& t) {
+  double a = 1, b = 0;
+  auto loss = [&](double pa, double pb) {
+    double l = 1e-6 * (pa * pa + pb * pb);
+    for (std::size_t i = 0; i < z.size(); ++i) {
+      const double u = pa * z[i] + pb;
+      l += std::max(u, 0.0) - u * t[i] + std::log1p(std::exp(-std::abs(u)));  // BCE with logits, stable
+    }
+    return l;
+  };
+  double current = loss(a, b);
+  for (int iter = 0; iter < 100; ++iter) {
+    double ga = 2e-6 * a, gb = 2e-6 * b, haa = 2e-6, hab = 0, hbb = 2e-6;
+    for (std::size_t i = 0; i < z.size(); ++i) {
+      const double p = 1.0 / (1.0 + std::exp(-(a * z[i] + b))), w = p * (1 - p), r = p - t[i];
+      ga += r * z[i], gb += r;
+      haa += w * z[i] * z[i], hab += w * z[i], hbb += w;
+    }
+    const double det = haa * hbb - hab * hab;
+    if (!(det > 0)) break;
+    double da = (hbb * ga - hab * gb) / det, db = (haa * gb - hab * ga) / det;
+    double next = loss(a - da, b - db);
+    for (int half = 0; half < 30 && next > current; ++half) da /= 2, db /= 2, next = loss(a - da, b - db);
+    if (next > current) break;
+    a -= da, b -= db;
+    const bool done = current - next < 1e-10 * std::max(1.0, current);
+    current = next;
+    if (done) break;
+  }
+  return {a, b};
+}
+
+}  // namespace
+
+PerClass<std::size_t> calibrateIntraRMScores(IntraRM* model, const std::vector<IntraRMFrame>& frames) {
+  IntraRMArch& arch = model->impl().info.config.model;
+  std::array<std::vector<double>, 3> z, t;
+  torch::InferenceMode guard;
+  for (const IntraRMFrame& f : frames) {
+    if (f.detections.empty()) continue;
+    const IntraRMInputs in = makeIntraRMInputs({&f.detections}, arch);
+    const torch::Tensor cls = model->impl().net->forward(in.basic, in.feat, in.source, in.target).cls.contiguous();
+    const float* pc = cls.data_ptr<float>();
+    for (std::size_t i = 0; i < f.detections.size(); ++i) {
+      const int c = classIndex(f.detections.boxes[i].label);
+      if (c < 0 || f.targets[i].cls_weight <= 0) continue;
+      z[static_cast<std::size_t>(c)].push_back(pc[3 * i + static_cast<std::size_t>(c)]);
+      t[static_cast<std::size_t>(c)].push_back(f.targets[i].cls[static_cast<std::size_t>(c)] > 0 ? 1.0 : 0.0);
+    }
+  }
+  PerClass<std::size_t> used;
+  for (std::size_t c = 0; c < 3; ++c) {
+    const double positives = std::accumulate(t[c].begin(), t[c].end(), 0.0);
+    used[c] = z[c].size();
+    if (positives < 1 || positives > static_cast<double>(z[c].size()) - 1) {
+      arch.score_scale[c] = 1, arch.score_bias[c] = 0;
+      continue;
+    }
+    const auto [a, b] = fitPlatt(z[c], t[c]);
+    const bool increasing = a > 0 && std::isfinite(a) && std::isfinite(b);
+    if (!increasing)  // a network whose scores do not rank this class: its scores are left as they are
+      RET3D_WARN("IntraRM score calibration: " << className(kDetectedClasses[c]) << "'s scores do not rise with its "
+                                               << "true positives (slope " << a << "); left uncalibrated");
+    arch.score_scale[c] = increasing ? a : 1.0, arch.score_bias[c] = increasing ? b : 0.0;
+  }
+  arch.validate();
+  return used;
+}
 
 }  // namespace relation
 }  // namespace ret3d

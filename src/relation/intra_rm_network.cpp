@@ -116,12 +116,23 @@ IntraRMInputs makeIntraRMInputs(const std::vector<const Detections*>& frames, co
   return in;
 }
 
-Detections applyIntraRMOutput(const Detections& input, const IntraRMOutput& out, bool refine_boxes) {
+torch::Tensor calibratedLogits(const torch::Tensor& cls, const IntraRMArch& arch) {
+  const torch::Tensor scale = torch::tensor({static_cast<float>(arch.score_scale[0]),
+                                             static_cast<float>(arch.score_scale[1]),
+                                             static_cast<float>(arch.score_scale[2])});
+  const torch::Tensor bias = torch::tensor({static_cast<float>(arch.score_bias[0]),
+                                            static_cast<float>(arch.score_bias[1]),
+                                            static_cast<float>(arch.score_bias[2])});
+  return cls * scale + bias;
+}
+
+Detections applyIntraRMOutput(const Detections& input, const IntraRMOutput& out, const IntraRMArch& arch) {
   Detections result = input;
   if (input.empty()) return result;
+  const bool refine_boxes = arch.refine_boxes;
   const torch::Tensor loc = out.loc.to(torch::kDouble).contiguous();
   const torch::Tensor box = out.box.to(torch::kDouble).contiguous();
-  const torch::Tensor prob = torch::sigmoid(out.cls).contiguous();
+  const torch::Tensor prob = torch::sigmoid(calibratedLogits(out.cls, arch)).contiguous();
   const double* pl = loc.data_ptr<double>();
   const double* pb = box.data_ptr<double>();
   const float* pc = prob.data_ptr<float>();

@@ -63,7 +63,9 @@ struct IntraRMInputs {
 IntraRMInputs makeIntraRMInputs(const std::vector<const Detections*>& frames, const IntraRMArch& arch);
 
 // Applies the predicted scores and (when refine_boxes) residuals to the input boxes.
-Detections applyIntraRMOutput(const Detections& input, const IntraRMOutput& out, bool refine_boxes = true);
+Detections applyIntraRMOutput(const Detections& input, const IntraRMOutput& out, const IntraRMArch& arch);
+// The class logits with the model's score calibration applied (IntraRMArch::score_scale, score_bias), N x 3.
+torch::Tensor calibratedLogits(const torch::Tensor& cls, const IntraRMArch& arch);
 
 }  // namespace relation
 }  // namespace ret3d

@@ -18,9 +18,9 @@
 
 #include "ret3d/core/log.h"
 #include "ret3d/core/progress.h"
-#include "ret3d/core/scan_matching.h"
 #include "ret3d/core/transform.h"
 #include "ret3d/eval/eval_data.h"
+#include "ret3d/io/ego_motion.h"
 #include "ret3d/io/kitti.h"
 #include "ret3d/io/sweeps.h"
 #include "ret3d/sim/sequence_writer.h"
@@ -45,46 +45,6 @@ struct AutolabelArgs {
 };
 
 double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-
-// LiDAR poses T_velo0_velo_t (one per frame index up to the last scan) from scan matching of consecutive scans, each
-// match started from the previous motion (constant velocity). A failed match keeps the previous motion (a warning).
-std::vector<Eigen::Isometry3d> estimatePoses(const kitti::TrackingDataset& ds, const std::string& seq) {
-  const std::vector<int> frames = ds.frames(seq);
-  std::vector<Eigen::Isometry3d> poses(frames.empty() ? 0 : static_cast<std::size_t>(frames.back()) + 1,
-                                       Eigen::Isometry3d::Identity());
-  PointCloud previous;
-  int previous_frame = -1;
-  Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
-  std::size_t failed = 0;
-  ProgressBar bar("ego motion " + seq, frames.size());
-  for (const int f : frames) {
-    PointCloud cloud = kitti::readVelodyne(ds.velodynePath(seq, f));
-    if (previous_frame >= 0) {
-      const ScanMatch m = matchScans(cloud, previous, motion);
-      if (m.converged) {
-        motion = m.source_to_target;
-      } else {
-        ++failed;
-        RET3D_WARN("sequence " << seq << ": scan matching of frame " << f << " to " << previous_frame << " failed ("
-                               << m.correspondences << " correspondences); the previous motion is kept");
-      }
-      poses[static_cast<std::size_t>(f)] = poses[static_cast<std::size_t>(previous_frame)] * motion;
-    }
-    // Frames missing before the next scan keep this pose.
-    for (int g = f + 1; g < static_cast<int>(poses.size()); ++g) poses[static_cast<std::size_t>(g)] = poses[f];
-    previous = std::move(cloud);
-    previous_frame = f;
-    bar.tick();
-  }
-  if (poses.size() > 1) {
-    const Eigen::Isometry3d& last = poses.back();
-    std::cout << "sequence " << seq << ": ego motion estimated from the scans (" << failed << " failed matches): "
-              << std::fixed << std::setprecision(1) << last.translation().head<2>().norm() << " m, "
-              << yawOf(last) * 180.0 / M_PI << " deg over " << poses.size() << " frames" << std::defaultfloat
-              << std::setprecision(6) << std::endl;
-  }
-  return poses;
-}
 
 void linkOrCopyScan(const std::string& from, const std::string& to, bool copy) {
   std::error_code ec;
@@ -128,7 +88,7 @@ void labelSequence(const AutolabelArgs& a, const kitti::TrackingDataset& ds, con
       RET3D_WARN("sequence " << seq << ": no ego poses; tracks are smoothed in the sensor frame");
     } else {
       const auto t0 = Clock::now();
-      poses = estimatePoses(ds, seq);
+      poses = io::estimateLidarPoses(ds, seq);
       totals->matching_s += secondsSince(t0);
     }
   }

@@ -6,10 +6,11 @@
 //                --intra-model models/kitti_pointrcnn/intra_rm.pt --data ../shared/data/kitti_tracking
 //                --sequences 16-20 --out out/pred_intra
 // With the `base` stage the boxes come from the LWD-3D detector on the folder's scans (the previous sweep moved by
-// the ego motion of pose/ or oxts/); without it they come from another detector's result files (--detections:
-// KITTI object/tracking result files or the per-class CSV layout). `--stages` lists what runs, in order:
-// base, intra (IntraRM), track (the CenterPoint-style tracker, real ego poses), inter (tracker + InterRM), or none
-// (the boxes pass through the same conversions: the fair baseline).
+// the ego motion of --poses, pose/ or oxts/, or else estimated from the scans by scan matching); without it they come
+// from another detector's result files (--detections: KITTI object/tracking result files or the per-class CSV layout).
+// `--stages` lists what runs, in order: base, intra (IntraRM), track (the CenterPoint-style tracker, in the fixed
+// frame of the ego poses), inter (tracker + InterRM), or none (the boxes pass through the same conversions: the fair
+// baseline).
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -24,6 +25,7 @@
 #include "ret3d/eval/eval_data.h"
 #include "ret3d/eval/velocity_error.h"
 #include "ret3d/io/detections.h"
+#include "ret3d/io/ego_motion.h"
 #include "ret3d/io/kitti.h"
 #include "ret3d/io/sweeps.h"
 #include "ret3d/io/track_velocity.h"
@@ -38,8 +40,23 @@ namespace fs = std::filesystem;
 
 struct DetectArgs {
   pipeline::PipelineConfig pipeline;
-  std::string data, detections, out, stages = "base", sequences, velocity_report;
+  std::string data, detections, out, stages = "base", sequences, velocity_report, poses;
 };
+
+// The ego poses of `seq` (--poses, pose/ or oxts/, else estimated from its scans); throws when the tracker needs
+// them and there are none, or when they end before the frames do.
+std::vector<Eigen::Isometry3d> egoPoses(const DetectArgs& a, const kitti::TrackingDataset& ds, const std::string& seq,
+                                        bool tracks, int last_frame) {
+  const auto poses = io::sequenceLidarPoses(ds, seq, {a.poses, /*scan_matching=*/true});
+  if (poses.empty() && tracks)
+    throw std::runtime_error("sequence " + seq + ": no ego poses for tracking (pose/ or oxts/, no scans to estimate "
+                             "them from); give --poses FILE");
+  if (!poses.empty() && last_frame >= static_cast<int>(poses.size()))
+    throw std::runtime_error("sequence " + seq + ": frame " + std::to_string(last_frame) + " beyond its " +
+                             std::to_string(poses.size()) + " ego poses" +
+                             (a.poses.empty() ? "" : " (" + a.poses + ")"));
+  return poses;
+}
 
 // Ground truth with velocities (from the track ids and the ego poses) of one labelled sequence, per frame.
 std::vector<eval::VelocityFrame> velocityGroundTruth(const kitti::TrackingDataset& ds, const std::string& seq,
@@ -124,6 +141,15 @@ std::size_t detectObjectFrames(const DetectArgs& a, DetectFrame detect) {
   return boxes;
 }
 
+// --sequences, or every sequence; --poses holds one sequence's poses.
+std::vector<std::string> sequencesToRun(const DetectArgs& a, const kitti::TrackingDataset& ds) {
+  const std::vector<std::string> seqs = a.sequences.empty() ? ds.sequences() : eval::parseSequenceList(a.sequences);
+  if (!a.poses.empty() && seqs.size() != 1)
+    throw std::runtime_error("--poses " + a.poses + " holds one sequence's poses; " + std::to_string(seqs.size()) +
+                             " sequences would run (give one with --sequences)");
+  return seqs;
+}
+
 // The base detector on a KITTI-layout folder's scans.
 std::size_t detectFromScans(const DetectArgs& a, pipeline::OfflinePipeline* p) {
   std::size_t boxes = 0;
@@ -136,23 +162,20 @@ std::size_t detectFromScans(const DetectArgs& a, pipeline::OfflinePipeline* p) {
     });
   }
   kitti::TrackingDataset ds(a.data);
-  const std::vector<std::string> seqs = a.sequences.empty() ? ds.sequences() : eval::parseSequenceList(a.sequences);
+  const std::vector<std::string> seqs = sequencesToRun(a, ds);
   std::size_t total_frames = 0;
   for (const std::string& seq : seqs) total_frames += ds.frames(seq).size();
   std::vector<eval::VelocityFrame> velocity;  // labelled sequences: predictions beside the ground truth
   ProgressBar bar("detect", total_frames);
   for (const std::string& seq : seqs) {
     const kitti::Calibration calib = ds.calibration(seq);
-    const auto poses = ds.lidarPoses(seq);
-    if (poses.empty()) {
-      if (p->tracks()) throw std::runtime_error("sequence " + seq + ": no ego poses (pose/ or oxts/) for tracking");
-      RET3D_WARN("sequence " << seq << ": no ego poses; the previous sweep is used unmoved");
-    }
+    const std::vector<int> frames = ds.frames(seq);
+    const auto poses = egoPoses(a, ds, seq, p->tracks(), frames.empty() ? -1 : frames.back());
     p->reset();
     std::vector<eval::VelocityFrame> vel;
     if (ds.hasLabels(seq)) vel = velocityGroundTruth(ds, seq, calib, poses);
     std::vector<kitti::Label> out;
-    io::forEachSweep(ds, seq, [&](const io::Sweep& s) {
+    io::forEachSweep(ds, seq, poses, [&](const io::Sweep& s) {
       const Detections d = p->run(s.cloud, s.previous, s.prev_to_current, {}, 0.1 * s.frame, s.pose);
       boxes += d.size();
       if (s.frame < static_cast<int>(vel.size())) vel[static_cast<std::size_t>(s.frame)].pred = d.boxes;
@@ -180,19 +203,15 @@ std::size_t detectFromResults(const DetectArgs& a, pipeline::OfflinePipeline* p)
     });
   }
   kitti::TrackingDataset ds(a.data);
-  const std::vector<std::string> seqs = a.sequences.empty() ? ds.sequences() : eval::parseSequenceList(a.sequences);
+  const std::vector<std::string> seqs = sequencesToRun(a, ds);
   ProgressBar bar("detect", seqs.size());
   for (const std::string& seq : seqs) {
     const kitti::Calibration calib = kitti::readCalibration(ds.calibPath(seq));
     std::vector<kitti::Label> out;
     const auto dets = io::readSequenceDetections(a.detections, layout, seq);
     if (p->tracks()) {
-      // Every frame in order (frames without detections too: tracks coast), at 10 Hz, with the real ego poses.
-      const auto poses = ds.lidarPoses(seq);
-      if (poses.empty()) throw std::runtime_error("sequence " + seq + ": no ego poses (pose/ or oxts/) for tracking");
-      if (!dets.empty() && dets.rbegin()->first >= static_cast<int>(poses.size()))
-        throw std::runtime_error("sequence " + seq + ": detections in frame " + std::to_string(dets.rbegin()->first) +
-                                 " beyond its " + std::to_string(poses.size()) + " poses");
+      // Every frame in order (frames without detections too: tracks coast), at 10 Hz, with the ego poses.
+      const auto poses = egoPoses(a, ds, seq, true, dets.empty() ? -1 : dets.rbegin()->first);
       p->reset();
       for (int frame = 0; frame < static_cast<int>(poses.size()); ++frame) {
         const auto it = dets.find(frame);
@@ -260,6 +279,9 @@ CommandRegistrar reg("detect", "run the pipeline offline (base detector, IntraRM
                  "config/tracker_lwd3d_pipeline.yaml, as the nodelets; with --detections config/tracker.yaml's "
                  "values, built in)");
   app.add_option("--sequences", a->sequences, "tracking sequences, e.g. 16-20 (default: all)");
+  app.add_option("--poses", a->poses, "ego poses of the one sequence run, in pose/SSSS.txt's format (camera poses, "
+                 "KITTI odometry convention; e.g. what `ret3d autolabel` writes). Default: pose/ or oxts/, else the "
+                 "ego motion is estimated from the scans (scan matching, as `ret3d autolabel`)");
   app.add_option("--out", a->out, "output folder for KITTI result files")->required();
   app.add_option("--threads", p.threads, "CPU threads for libtorch")->capture_default_str();
   app.add_option("--velocity-report", a->velocity_report,

@@ -39,6 +39,7 @@ struct EvalArgs {
   std::string mot_similarity = "iou3d";
   double mot_threshold = 0.5, mot_zero_distance = 2.0, mot_max_range = 0;
   std::string kitti_recall = "devkit";
+  int min_points = 0;
   int threads = 2;
 };
 
@@ -207,7 +208,7 @@ void evalKitti(const EvalArgs& a, const std::vector<ObjectClass>& classes, const
                EvalReport* report) {
   std::vector<KittiFrame> frames;
   frames.reserve(data.frames.size());
-  for (const auto& f : data.frames) frames.push_back({f.gt_labels, f.pred_labels});
+  for (const auto& f : data.frames) frames.push_back({f.gt_labels, f.pred_labels, f.gt_label_ignore});
   KittiApOptions o;
   o.classes = classes;
   o.exact_recall = a.kitti_recall == "exact";
@@ -282,6 +283,12 @@ int runEval(const EvalArgs& a) {
   EvalData data = loadData(a, gt_format, pred_bag, sequences);
   if (pred_bag) attachPredictionBag(a, gt_format == "bag", bag_calib, data, &report);
 
+  if (a.min_points > 0) {
+    std::optional<ProgressBar> bar;
+    report.min_points = a.min_points;
+    report.min_points_counts = ignoreLabelsWithFewReturns(data, a.min_points, a.threads, stageBar(bar, "returns"));
+    report.label_returns = labelReturns(data);
+  }
   report.gt_source = data.gt_description;
   report.pred_source = data.pred_description;
   report.num_frames = data.frames.size();
@@ -348,6 +355,13 @@ CommandRegistrar registrar(
                      "class and difficulty) or exact (precision at actual recall k/40; for small sets)")
           ->capture_default_str()
           ->check(CLI::IsMember({"devkit", "exact"}));
+      app.add_option("--min-points", a->min_points,
+                     "ignore, in every metric, ground-truth labels holding fewer than this many returns of their "
+                     "frame's scan (points in the box grown by 0.1 m; as the Waymo Open Dataset): an unmatched one is "
+                     "no miss, a prediction on it neither a true nor a false positive. Needs the scans beside the "
+                     "labels (velodyne/); counts per label in REPORT_DIR/label_returns.csv. 0 = off")
+          ->capture_default_str()
+          ->check(CLI::NonNegativeNumber);
       app.add_option("--threads", a->threads, "worker threads")->capture_default_str()->check(CLI::PositiveNumber);
       return [a]() -> int { return runEval(*a); };
     });

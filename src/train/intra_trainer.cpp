@@ -149,6 +149,17 @@ IntraTrainReport trainIntraRM(const std::vector<IntraRMFrame>& train, const std:
   if (train.empty()) throw std::runtime_error("IntraRM training: no training frames with detections");
   trainRelationModule<relation::IntraRMLearner>("IntraRM", options, options.config.train.frames_per_batch, train, val,
                                                 &report);
+  // The saved model's scores made probabilities of a true positive, fitted on the training frames.
+  relation::IntraRMOptions saved;
+  saved.model_path = options.out_path;
+  relation::IntraRM model(saved);
+  const PerClass<std::size_t> used = relation::calibrateIntraRMScores(&model, train);
+  model.save(options.out_path);
+  const relation::IntraRMArch& a = model.arch();
+  for (std::size_t c = 0; c < 3; ++c)
+    RET3D_INFO("IntraRM score calibration " << className(kDetectedClasses[c]) << ": sigmoid(" << a.score_scale[c]
+                                            << " * logit + " << a.score_bias[c] << "), fitted on " << used[c]
+                                            << " boxes");
   return report;
 }
 

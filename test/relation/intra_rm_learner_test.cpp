@@ -1,5 +1,6 @@
 #include "ret3d/relation/intra_rm_learner.h"
 
+#include <array>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -54,6 +55,49 @@ TEST(IntraRMLearner, ATinyTrainingRunLowersTheLossAndMovesBoxesTowardsTheTruth) 
   }
   ASSERT_GT(n, 50);
   EXPECT_LT(err_after / n, 0.75 * err_before / n);
+}
+
+// The focal loss leaves the raw sigmoid below the chance that a box is right; after calibration the published score
+// is that chance: over the boxes it was fitted on, the mean score equals the fraction of true positives (a property of
+// the logistic fit), per class, and the calibration travels with the model file.
+TEST(IntraRMLearner, CalibratedScoresAreTheChanceOfATruePositive) {
+  std::mt19937 rng(2);
+  std::vector<IntraRMFrame> train;
+  for (int i = 0; i < 48; ++i) train.push_back(test::randomFrame(rng, 10));
+  IntraRMLearner learner(smallConfig(), 3);
+  learner.fitNormalisation(train);
+  for (int epoch = 0; epoch < 3; ++epoch) {
+    for (std::size_t s = 0; s < train.size(); s += 16) {
+      std::vector<const IntraRMFrame*> batch;
+      for (std::size_t f = s; f < s + 16; ++f) batch.push_back(&train[f]);
+      learner.step(batch);
+    }
+  }
+  ret3d::test::TempDir tmp;
+  learner.model().save(tmp / "intra.pt");
+  IntraRMOptions o;
+  o.model_path = tmp / "intra.pt";
+  IntraRM model(o);
+  const PerClass<std::size_t> used = calibrateIntraRMScores(&model, train);
+  model.save(tmp / "intra.pt");
+  const IntraRM loaded(o);
+  std::array<double, 3> score{}, positives{};
+  for (const IntraRMFrame& f : train) {
+    const Detections r = loaded.refine(f.detections);
+    for (std::size_t i = 0; i < r.size(); ++i) {
+      const std::size_t c = static_cast<std::size_t>(classIndex(r.boxes[i].label));
+      if (f.targets[i].cls_weight <= 0) continue;
+      score[c] += r.boxes[i].score;
+      positives[c] += f.targets[i].cls[c];
+    }
+  }
+  for (std::size_t c = 0; c < 3; ++c) {
+    ASSERT_GT(used[c], 50u);
+    EXPECT_NE(loaded.arch().score_scale[c], 1.0) << c;
+    EXPECT_EQ(loaded.arch().score_scale[c], model.arch().score_scale[c]);
+    EXPECT_EQ(loaded.arch().score_bias[c], model.arch().score_bias[c]);
+    EXPECT_NEAR(score[c] / static_cast<double>(used[c]), positives[c] / static_cast<double>(used[c]), 0.01) << c;
+  }
 }
 
 TEST(IntraRMLearner, CheckpointResumesTheSameState) {

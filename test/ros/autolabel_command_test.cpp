@@ -42,13 +42,16 @@ class AutolabelCommand : public ::testing::Test {
     std::ofstream(tmp_ / "tracker.yaml") << yaml;
   }
 
-  // `ret3d autolabel` on `data` into `out`; every box the untrained detector finds is tracked, kept and labelled.
-  int autolabel(const std::string& data, const std::string& out, std::string* output,
-                const std::vector<std::string>& extra = {}) {
+  // `ret3d COMMAND` (autolabel or detect) on `data` into `out` with the tiny models; every box the untrained
+  // detector finds is tracked (and, by autolabel, kept and labelled).
+  int run(const std::string& command_name, const std::string& data, const std::string& out, std::string* output,
+          const std::vector<std::string>& extra = {}) {
     std::vector<std::string> command = {
-        RET3D_CLI, "autolabel", "--data", data, "--out", out, "--models", tmp_ / "models", "--detector-config",
-        tmp_ / "models/detector.yaml", "--threads", "1", "--score-threshold", "0", "--min-track-length", "1",
-        "--min-track-score", "0", "--tracker-config", tmp_ / "tracker.yaml"};
+        RET3D_CLI, command_name, "--data", data, "--out", out, "--models", tmp_ / "models", "--detector-config",
+        tmp_ / "models/detector.yaml", "--threads", "1", "--score-threshold", "0", "--tracker-config",
+        tmp_ / "tracker.yaml"};
+    if (command_name == "autolabel")
+      command.insert(command.end(), {"--min-track-length", "1", "--min-track-score", "0"});
     command.insert(command.end(), extra.begin(), extra.end());
     const std::string log = out + ".log";
     const int code = test::runLogged(command, log, 120.0);
@@ -57,6 +60,20 @@ class AutolabelCommand : public ::testing::Test {
     ss << in.rdbuf();
     *output = ss.str();
     return code;
+  }
+  int autolabel(const std::string& data, const std::string& out, std::string* output,
+                const std::vector<std::string>& extra = {}) {
+    return run("autolabel", data, out, output, extra);
+  }
+
+  // The scans of the tiny sequence as a plain folder (no poses, no calibration).
+  void writeScanFolder(const std::string& dir) {
+    fs::create_directories(dir);
+    for (int f = 0; f < kScans; ++f) {
+      char name[16];
+      std::snprintf(name, sizeof(name), "%06d.bin", f);
+      fs::copy_file(tmp_ / ("tracking/training/velodyne/0004/" + std::string(name)), dir + "/" + name);
+    }
   }
 
   // The written dataset as the detector trainer reads it.
@@ -91,18 +108,44 @@ TEST_F(AutolabelCommand, TrackingLayoutBecomesATrainableDataset) {
 }
 
 TEST_F(AutolabelCommand, ScanFolderGetsEstimatedPosesAndDefaultCalibration) {
-  fs::create_directories(tmp_ / "scans");
-  for (int f = 0; f < kScans; ++f) {
-    char name[16];
-    std::snprintf(name, sizeof(name), "%06d.bin", f);
-    fs::copy_file(tmp_ / ("tracking/training/velodyne/0004/" + std::string(name)),
-                  tmp_ / ("scans/" + std::string(name)));
-  }
+  writeScanFolder(tmp_ / "scans");
   std::string output;
   ASSERT_EQ(autolabel(tmp_ / "scans", tmp_ / "out", &output), 0) << output;
   EXPECT_NE(output.find("ego motion estimated"), std::string::npos) << output;
   expectTrainable(tmp_ / "out", "0000", output);
   EXPECT_TRUE(kitti::readCalibration(tmp_ / "out/training/calib/0000.txt").P2.isApprox(kitti::defaultCalibration().P2));
+}
+
+// `ret3d detect` runs the same pipeline as autolabel: on scans without poses it estimates the ego motion the same
+// way and tracks, or takes the poses from --poses.
+TEST_F(AutolabelCommand, DetectTracksAScanFolderWithoutPosesAsAutolabelDoes) {
+  writeScanFolder(tmp_ / "scans");
+  std::string output;
+  ASSERT_EQ(run("detect", tmp_ / "scans", tmp_ / "pred", &output, {"--stages", "base,intra,track,inter"}), 0) << output;
+  EXPECT_NE(output.find("estimating the ego motion from the scans"), std::string::npos) << output;
+  EXPECT_NE(output.find("ego motion estimated"), std::string::npos) << output;
+  const auto labels = kitti::readTrackingLabels(tmp_ / "pred/0000.txt");
+  ASSERT_FALSE(labels.empty()) << output;
+  for (const kitti::Label& l : labels) EXPECT_GE(l.track_id, 0) << "every box of the track stage has a track id";
+
+  // The poses given: no estimation, the same frames tracked.
+  ASSERT_EQ(run("detect", tmp_ / "scans", tmp_ / "pred_poses", &output,
+                {"--stages", "base,intra,track,inter", "--poses", tmp_ / "tracking/training/pose/0004.txt"}),
+            0)
+      << output;
+  EXPECT_EQ(output.find("estimating the ego motion"), std::string::npos) << output;
+  EXPECT_FALSE(kitti::readTrackingLabels(tmp_ / "pred_poses/0000.txt").empty()) << output;
+
+  // A pose file that is not there, or shorter than the scans, is refused by name.
+  EXPECT_NE(run("detect", tmp_ / "scans", tmp_ / "pred_bad", &output,
+                {"--stages", "base,track", "--poses", tmp_ / "missing.txt"}),
+            0);
+  EXPECT_NE(output.find("missing.txt"), std::string::npos) << output;
+  std::ofstream(tmp_ / "short.txt") << "1 0 0 0 0 1 0 0 0 0 1 0\n";
+  EXPECT_NE(run("detect", tmp_ / "scans", tmp_ / "pred_bad", &output,
+                {"--stages", "base,track", "--poses", tmp_ / "short.txt"}),
+            0);
+  EXPECT_NE(output.find("beyond its 1 ego poses"), std::string::npos) << output;
 }
 
 TEST_F(AutolabelCommand, RefusesAnObjectLayoutAndStagesWithoutTracking) {

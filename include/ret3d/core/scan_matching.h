@@ -1,8 +1,9 @@
 // Ego motion between two consecutive LiDAR scans without poses, from voxel-downsampled non-ground points, in the
 // ground plane (x, y, yaw): the ground is left out (it constrains only z, roll and pitch), and road vehicles move in
 // that plane. Two registrations (ScanMatcher): a small point-to-plane ICP written here, with a voxel hash for the
-// nearest neighbours, and PCL's generalized ICP on the same points. Used by `ret3d autolabel` for scan folders that
-// come without poses; `ret3d egomotion` measures both (docs/RESULTS.md, "Ego motion from the scans").
+// nearest neighbours, and PCL's generalized ICP on the same points. Used for
+// scan folders that come without poses (io/ego_motion.h: `ret3d autolabel`, `ret3d detect`); `ret3d egomotion` measures
+// both (docs/RESULTS.md, "Ego motion from the scans").
 #pragma once
 
 #include <Eigen/Geometry>

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <map>
 #include <optional>
@@ -34,6 +35,13 @@ struct EvalFrame {
   // (Van for Car, Person_sitting for Pedestrian): a prediction on it is neither a true nor a false positive.
   std::vector<char> gt_ignore;
   std::vector<Box> pred_boxes;
+  // Parallel to gt_boxes: the index in gt_labels each box was made from (empty for ground truth not from labels).
+  std::vector<int> gt_box_label;
+  // Parallel to gt_boxes once counted (ignoreLabelsWithFewReturns): the scan's returns inside each box grown by
+  // kLabelReturnMargin on every side.
+  std::vector<std::uint32_t> gt_returns;
+  // Parallel to gt_labels (empty: none): labels every metric ignores (too few returns), for the KITTI metrics.
+  std::vector<char> gt_label_ignore;
 
   std::string velodyne_path;  // the scan, when available (Waymo difficulty from point counts)
 };
@@ -77,6 +85,39 @@ EvalData loadKittiObject(const std::string& gt_root, const std::string& pred_dir
 // `threads` threads; sets gt_has_point_counts when some frame was counted. Returns the number of frames counted.
 std::size_t countGroundTruthPoints(EvalData& data, int threads = 2,
                                    const std::function<void(std::size_t, std::size_t)>& progress = nullptr);
+
+// Returns of a label are the scan's points inside its box grown by this much (m) on every side (a box drawn tight to
+// the object's surface leaves its own returns on the boundary).
+inline constexpr double kLabelReturnMargin = 0.1;
+
+// Labels per class holding enough returns, and those ignored for holding fewer than the minimum.
+struct MinPointsCounts {
+  std::size_t kept = 0, ignored = 0;
+};
+
+// The Waymo Open Dataset's rule for objects the sensor barely sees: counts the returns of every ground-truth box
+// from its frame's scan (gt_returns) and marks the boxes with fewer than `min_points` as ignored by every metric
+// (gt_ignore, and gt_label_ignore for the KITTI metrics): an unmatched one is not a miss, a prediction matched to it
+// neither a true nor a false positive. Throws naming the frame when ground truth comes without its scan
+// (velodyne_path) or not from labels (a bag). Returns the counts per class of Car, Pedestrian, Cyclist (Van and
+// Person_sitting, ignored anyway, are not counted in them).
+std::map<ObjectClass, MinPointsCounts> ignoreLabelsWithFewReturns(
+    EvalData& data, int min_points, int threads = 2,
+    const std::function<void(std::size_t, std::size_t)>& progress = nullptr);
+
+// One counted ground-truth label: where it is, what it is and the returns it holds.
+struct LabelReturns {
+  std::string sequence;
+  int frame = 0;
+  int label = 0;  // index in the frame's label file (gt_labels)
+  std::string type;
+  int track_id = -1;
+  double range = 0;  // m, horizontal from the sensor
+  std::uint32_t returns = 0;
+  bool ignored = false;  // by every metric (too few returns, or a neighbouring class)
+};
+// Every label counted by ignoreLabelsWithFewReturns, frame by frame.
+std::vector<LabelReturns> labelReturns(const EvalData& data);
 
 // Parses "1,3-5,0007" into {"0001","0003","0004","0005","0007"} (four-digit sequence names).
 std::vector<std::string> parseSequenceList(const std::string& text);

@@ -34,6 +34,9 @@ inline constexpr double kKittiMaxTruncation[3] = {0.15, 0.3, 0.5};
 struct KittiFrame {
   std::vector<kitti::Label> gt;
   std::vector<kitti::Label> det;
+  // Parallel to gt (empty: none): labels ignored as the devkit ignores a neighbouring class (e.g. too few returns,
+  // EvalFrame::gt_label_ignore): no miss when unmatched, a detection on it neither a true nor a false positive.
+  std::vector<char> gt_ignore;
 };
 
 struct KittiApOptions {

@@ -8,7 +8,8 @@
 //
 // Outputs: the same detections, in the same order, with refined centre, size and yaw (residuals on the input box;
 // the heading residual is at most pi/2, direction flips are left alone), the score replaced by the refined
-// probability of the box's own class, and everything else (label, velocity, track id, point count, features) kept.
+// probability of the box's own class (calibrated: IntraRMArch::score_scale), and everything else (label, velocity,
+// track id, point count, features) kept.
 #pragma once
 
 #include <cstdint>

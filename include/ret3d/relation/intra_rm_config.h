@@ -24,6 +24,13 @@ struct IntraRMArch {
   // trained, eq. (5) unchanged). For a detector whose boxes come from its points (PointRCNN), box-level context
   // alone does not locate a box better than the detector did (docs/RESULTS.md, IntraRM).
   bool refine_boxes = true;
+  // The published score of a box of class c is sigmoid(score_scale[c] * logit + score_bias[c]) of its class channel:
+  // Platt scaling fitted after training (calibrateIntraRMScores), so that it is the probability that the box is a
+  // true positive of its class, the scale a tracker's thresholds are set in. The focal loss the network learns by
+  // (alpha 0.25, gamma 2) ranks boxes well but leaves the raw sigmoid of a true positive far below that probability,
+  // unequally per class. Identity (1, 0) in a model without it.
+  PerClass<double> score_scale{1.0, 1.0, 1.0};
+  PerClass<double> score_bias{0.0, 0.0, 0.0};
 
   void validate() const;  // throws std::invalid_argument naming the field
 };

@@ -30,5 +30,12 @@ std::ostream& operator<<(std::ostream& out, const IntraRMLoss& loss);  // its te
 // and the spread of the regression targets; step: a rotation about the sensor's z axis and a mirror per frame.
 using IntraRMLearner = RelationLearner<IntraRM, IntraRMFrame, IntraRMLoss>;
 
+// Fits each class's score calibration (IntraRMArch::score_scale, score_bias: Platt scaling, logistic regression of
+// the box's target on its class logit) on `frames` without augmentation, boxes the loss ignores left out, and stores
+// it in `model` (its network unchanged; save() writes it). A class without both positives and negatives, or whose
+// scores do not rise with its true positives (a warning), keeps the identity. Returns the boxes per class it was
+// fitted on.
+PerClass<std::size_t> calibrateIntraRMScores(IntraRM* model, const std::vector<IntraRMFrame>& frames);
+
 }  // namespace relation
 }  // namespace ret3d
