@@ -46,13 +46,12 @@ constexpr int kSeed = 4242;
 // dropped 3 of 100 scans while the hypervisor took 20-26 % of the CPU and the detector ran 4-6 times slower than idle.
 constexpr double kRate = 0.25;
 // Mean 3D AP R40 moderate over the three classes (KITTI devkit rules, front camera view; the figure the model card
-// selects heads by). The default models of models/lwd3d (session 4: 24-epoch detector with IoU channels and box
-// voting, IntraRM m 1, InterRM N 30) score 61.5 on this drive (Car 46.2, Pedestrian 66.2, Cyclist 71.9); the
-// session-3 models scored 59.1, the session-2 ones 51.2, the same in repeated runs. The bound is about two thirds of
-// today's figure. An untrained detector scores 0.0. The bound holds for this drive only: drives differ a lot (seed
-// 4343 scored 34.7 with the session-2 models). Session 10's simulator (zero-intensity returns, foliage, hedges,
-// bushes, bollards) made the drive harder: the session-8 models scored 40.8 on it, the session-10 ones 54.2.
-constexpr double kMinMeanAp = 40.0;
+// selects heads by). On this drive, with the simulator of car paints of every colour, queues and roadside structures,
+// the default models score 27.5 (Car 17.4, Pedestrian 48.5, Cyclist 16.5: most of its cars are parked dark ones), the
+// previous default detector 29.5; an untrained detector scores 0.0. One drive is a small sample (on the fresh
+// held-out set of docs/RESULTS.md, 300 frames, the same models score 58.0 / 57.7 / 70.0): the bound, about two thirds
+// of today's figure, tells a working pipeline from a broken one, not one model from another.
+constexpr double kMinMeanAp = 18.0;
 // Percent of matched ground-truth track-frames (issue 8). The pipeline's tracker (config/tracker_lwd3d_pipeline.yaml:
 // birth 0.3, pedestrian gate 0.8 m, max_age 10) gives 95.1 % on this drive with the session-4 models (95.2 % with
 // the session-3 ones, 94.9-96.2 % with the session-2 ones); the earlier birth 0.05 / gate 0.4 m measured 85.5 % (Car 91.4, Pedestrian 76.9, Cyclist
