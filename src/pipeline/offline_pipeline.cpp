@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "ret3d/detector/model_file.h"
+#include "ret3d/pipeline/stage_layout.h"
 #include "ret3d/pipeline/tracker_default.h"
 #include "ret3d/tracking/tracker_options.h"
 
@@ -47,7 +48,10 @@ bool has(const std::vector<std::string>& v, const std::string& s) { return std::
 }  // namespace
 
 std::vector<std::string> parseStages(const std::string& list) {
-  static const std::vector<std::string> kOrder = {"base", "intra", "track", "inter"};
+  // The stages in the order of the pipeline's layout (pipeline/stage_layout.h): base, intra, track, inter.
+  static const std::vector<std::string> kOrder = offlineStageNames();
+  std::string known, order;
+  for (const std::string& s : kOrder) known += s + ", ", order += (order.empty() ? "" : ", ") + s;
   std::vector<std::string> out;
   std::stringstream ss(list);
   std::string item;
@@ -55,10 +59,10 @@ std::vector<std::string> parseStages(const std::string& list) {
     if (item.empty() || item == "none") continue;
     const auto it = std::find(kOrder.begin(), kOrder.end(), item);
     if (it == kOrder.end())
-      throw std::runtime_error("--stages: unknown stage '" + item + "' (known: base, intra, track, inter, none)");
+      throw std::runtime_error("--stages: unknown stage '" + item + "' (known: " + known + "none)");
     if (!out.empty() && std::find(kOrder.begin(), kOrder.end(), out.back()) >= it)
       throw std::runtime_error("--stages: '" + item + "' after '" + out.back() +
-                               "' (the order is base, intra, track, inter)");
+                               "' (the order is " + order + ")");
     out.push_back(item);
   }
   if (has(out, "track") && has(out, "inter")) out.erase(std::find(out.begin(), out.end(), "track"));
