@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "ret3d/detector/model_file.h"
+#include "ret3d/pipeline/score_threshold.h"
 #include "ret3d/pipeline/stage_layout.h"
 #include "ret3d/pipeline/tracker_default.h"
 #include "ret3d/tracking/tracker_options.h"
@@ -70,7 +71,7 @@ std::vector<std::string> parseStages(const std::string& list) {
 }
 
 bool usesPackageDir(const PipelineConfig& c) {
-  // The nodelets' tracker config and the threshold their detector feeds it from (pipelineDetectorThreshold).
+  // The nodelets' tracker config and the threshold their detector feeds it from (params_score_threshold).
   return (c.tracker_config.empty() || c.score_threshold < 0) && has(c.stages, "base") &&
          (has(c.stages, "track") || has(c.stages, "inter"));
 }
@@ -85,12 +86,11 @@ OfflinePipeline::OfflinePipeline(const PipelineConfig& c) : stages_(c.stages) {
         resolveModel(c.detector_model, c.models, "detector.pt", "base", "a detector model", "--detector-model");
     DetectorOptions o = detectorOptionsForModel(path, c.detector_config);
     o.inference.threads = c.threads;
-    if (c.score_threshold >= 0) {
-      o.inference.score_threshold = c.score_threshold;
-    } else if (has(stages_, "track") || has(stages_, "inter")) {  // as the nodelets feed their tracker
-      o.inference.score_threshold =
-          static_cast<float>(pipelineDetectorThreshold(c.package_dir, o.inference.score_threshold));
-    }
+    // As the nodelets feed their tracker: pipeline/score_threshold.h says which source wins.
+    const bool tracks = has(stages_, "track") || has(stages_, "inter");
+    o.inference.score_threshold =
+        chooseScoreThreshold(o.inference.score_threshold, c.params_score_threshold, tracks,
+                             c.score_threshold >= 0 ? std::optional<double>(c.score_threshold) : std::nullopt);
     try {
       if (!c.grid_extent.empty()) o.inference.grid_extent = GridExtent::fromValues(c.grid_extent);
       o.validate();

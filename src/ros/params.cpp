@@ -4,10 +4,13 @@
 #include <ros/names.h>
 #include <ros/package.h>
 
+#include <filesystem>
 #include <sstream>
 #include <yaml-cpp/yaml.h>
 
+#include "ret3d/core/yaml_reader.h"
 #include "ret3d/detector/model_file.h"
+#include "ret3d/pipeline/score_threshold.h"
 
 namespace ret3d {
 namespace {
@@ -166,6 +169,15 @@ std::string packagePath() { return ros::package::getPath("ret3d"); }
 
 std::string defaultModelPath(const std::string& file_name) { return packagePath() + "/models/lwd3d/" + file_name; }
 
+std::optional<double> nodeletParamsScoreThreshold(const std::string& package_dir) {
+  const std::string path = (std::filesystem::path(package_dir) / kNodeletParams).string();
+  if (package_dir.empty() || !std::filesystem::exists(path)) return std::nullopt;
+  double v = 0;
+  if (!YamlReader::load(path).child("ret3d_detector").get("score_threshold", &v, InferenceOptions::kScoreThreshold))
+    return std::nullopt;
+  return v;
+}
+
 StageParams loadStageParams(const ros::NodeHandle& private_nh) {
   const ParamReader p(private_nh);
   StageParams params;
@@ -193,7 +205,12 @@ DetectorNodeletParams loadDetectorNodeletParams(const ros::NodeHandle& private_n
   using I = InferenceOptions;
   InferenceOptions& inf = params.detector.inference;
   inf.threads = p.integer("threads", inf.threads, I::kThreads);
-  inf.score_threshold = static_cast<float>(p.number("score_threshold", inf.score_threshold, I::kScoreThreshold));
+  // ~score_threshold: config/ret3d.yaml's value, or the launch file's / command line's (pipeline/score_threshold.h).
+  const std::optional<double> score_threshold =
+      p.has("score_threshold") ? std::optional<double>(p.number("score_threshold", 0, I::kScoreThreshold))
+                               : std::nullopt;
+  inf.score_threshold =
+      pipeline::chooseScoreThreshold(inf.score_threshold, score_threshold, /*tracks=*/true, std::nullopt);
   inf.candidate_threshold =
       static_cast<float>(p.number("candidate_threshold", inf.candidate_threshold, I::kCandidateThreshold));
   inf.nms_iou = p.number("nms_iou", inf.nms_iou, I::kNmsIou);

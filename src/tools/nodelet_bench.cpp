@@ -1089,7 +1089,7 @@ BusyLoad::~BusyLoad() {
 int runNodeletBench(const NodeletBenchOptions& o, NodeletBenchResult* result) {
   checkOptions(o);
   const std::vector<Stage> stages = pipelineStages(o);
-  const std::string params = o.params.empty() ? packagePath() + "/config/ret3d.yaml" : o.params;
+  const std::string params = o.params.empty() ? packagePath() + "/" + kNodeletParams : o.params;
   if (packagePath().empty() && (o.params.empty() || o.tracker_config.empty()))
     throw std::runtime_error("the ret3d package is not on ROS_PACKAGE_PATH (`source scripts/env.sh`), so its "
                              "config/ret3d.yaml cannot be found; or give --params FILE");

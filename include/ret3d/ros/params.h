@@ -7,6 +7,7 @@
 #include <ros/node_handle.h>
 #include <xmlrpcpp/XmlRpcValue.h>
 
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -60,6 +61,13 @@ std::string toYaml(const XmlRpc::XmlRpcValue& value);
 std::string packagePath();
 // Default model files: $(find ret3d)/models/lwd3d/{detector,intra_rm,inter_rm}.pt.
 std::string defaultModelPath(const std::string& file_name);
+
+// The nodelets' parameter file (one section per node name), relative to the package.
+inline constexpr const char* kNodeletParams = "config/ret3d.yaml";
+// Its ret3d_detector/score_threshold in the package at `package_dir` (checked against InferenceOptions'
+// range), for the offline pipeline (pipeline::PipelineConfig::params_score_threshold); nullopt without the file or
+// the key. The same value the launch file gives the detector nodelet as ~score_threshold.
+std::optional<double> nodeletParamsScoreThreshold(const std::string& package_dir);
 
 // What every stage that needs the sensor's pose shares.
 struct PoseParams {
