@@ -294,19 +294,17 @@ InterRMNodeletParams loadInterRMNodeletParams(const ros::NodeHandle& private_nh)
   params.inter.threads = p.integer("threads", 2, 1, 64);
   params.pose = loadPoseParams(p);
   if (params.passthrough) return params;  // no histories kept
-  // The tracker's own configuration, read as the tracker nodelet reads it (one home for max_age).
+  // The tracker's own options, from its tracker_config (or inline ~tracker) read as the tracker nodelet reads them:
+  // the one home of max_age.
   const std::string tracker_node = p.nonEmpty("tracker_node", "ret3d_tracker");
   const ros::NodeHandle tracker_nh(ros::NodeHandle(ros::names::parentNamespace(private_nh.getNamespace())),
                                    tracker_node);
-  const int tracker_max_age = loadTrackerNodeletParams(tracker_nh).tracker.max_age;
-  params.max_age = p.integer("max_age", tracker_max_age, 0, 1000);
-  if (params.max_age != tracker_max_age) {
-    params.max_age_warning = "parameter " + p.fullName("max_age") + " = " + std::to_string(params.max_age) +
-                             " differs from the tracker's max_age " + std::to_string(tracker_max_age) + " (" +
-                             tracker_nh.getNamespace() + "): track histories " +
-                             (params.max_age < tracker_max_age ? "of coasting tracks are dropped before they end"
-                                                               : "are kept longer than their tracks") +
-                             "; remove ~max_age to follow the tracker";
+  params.tracker = loadTrackerNodeletParams(tracker_nh).tracker;
+  if (p.has("max_age")) {
+    params.ignored_warning = "parameter " + p.fullName("max_age") + " is no longer read (ignored): track histories " +
+                             "follow the tracker's max_age " + std::to_string(params.tracker.max_age) + " (" +
+                             tracker_nh.resolveName("tracker_config") + " or " + tracker_nh.resolveName("tracker") +
+                             "); remove it";
   }
   return params;
 }

@@ -107,12 +107,12 @@ struct InterRMNodeletParams {
   // ~publish_detections: the objects also as vision_msgs/Detection3DArray on objects/detections (ros/detection3d.h)
   bool publish_detections = true;
   PoseParams pose;
-  // Histories of track ids not seen for more than this many frames are dropped: the tracker's max_age, read from the
-  // tracker nodelet's own parameters (~tracker_node, default "ret3d_tracker", a sibling of this nodelet), since a
-  // track that coasts longer than that never comes back with the same id. ~max_age, when set, overrides it (kept for
-  // older parameter files; a warning when it differs from the tracker's).
-  int max_age = TrackerOptions().max_age;
-  std::string max_age_warning;       // non-empty: ~max_age disagrees with the tracker's (the nodelet logs it)
+  // The tracker's options, from the tracker nodelet's own parameters (its tracker_config or inline tracker; the
+  // nodelet named by ~tracker_node, default "ret3d_tracker", a sibling of this one): histories of track ids not seen
+  // for more than tracker.max_age frames are dropped, since a track that coasts longer never comes back with that id.
+  TrackerOptions tracker;
+  // Non-empty: ~max_age is set, which is no longer read (the nodelet logs this warning).
+  std::string ignored_warning;
 };
 struct MarkerNodeletParams {
   MarkerOptions markers;
@@ -123,7 +123,7 @@ StageParams loadStageParams(const ros::NodeHandle& private_nh);
 DetectorNodeletParams loadDetectorNodeletParams(const ros::NodeHandle& private_nh);
 IntraRMNodeletParams loadIntraRMNodeletParams(const ros::NodeHandle& private_nh);
 TrackerNodeletParams loadTrackerNodeletParams(const ros::NodeHandle& private_nh);
-// Reads the tracker's max_age from the tracker nodelet's parameters with loadTrackerNodeletParams (its namespace:
+// Reads the tracker's options from the tracker nodelet's parameters with loadTrackerNodeletParams (its namespace:
 // ~tracker_node resolved in private_nh's parent namespace).
 InterRMNodeletParams loadInterRMNodeletParams(const ros::NodeHandle& private_nh);
 MarkerNodeletParams loadMarkerNodeletParams(const ros::NodeHandle& private_nh);
