@@ -8,6 +8,8 @@
 #include <stdexcept>
 
 #include "ret3d/detector/model_file.h"
+#include "ret3d/pipeline/score_threshold.h"
+#include "ret3d/pipeline/stage_layout.h"
 #include "ret3d/pipeline/tracker_default.h"
 #include "ret3d/tracking/tracker_options.h"
 
@@ -47,7 +49,10 @@ bool has(const std::vector<std::string>& v, const std::string& s) { return std::
 }  // namespace
 
 std::vector<std::string> parseStages(const std::string& list) {
-  static const std::vector<std::string> kOrder = {"base", "intra", "track", "inter"};
+  // The stages in the order of the pipeline's layout (pipeline/stage_layout.h): base, intra, track, inter.
+  static const std::vector<std::string> kOrder = offlineStageNames();
+  std::string known, order;
+  for (const std::string& s : kOrder) known += s + ", ", order += (order.empty() ? "" : ", ") + s;
   std::vector<std::string> out;
   std::stringstream ss(list);
   std::string item;
@@ -55,10 +60,10 @@ std::vector<std::string> parseStages(const std::string& list) {
     if (item.empty() || item == "none") continue;
     const auto it = std::find(kOrder.begin(), kOrder.end(), item);
     if (it == kOrder.end())
-      throw std::runtime_error("--stages: unknown stage '" + item + "' (known: base, intra, track, inter, none)");
+      throw std::runtime_error("--stages: unknown stage '" + item + "' (known: " + known + "none)");
     if (!out.empty() && std::find(kOrder.begin(), kOrder.end(), out.back()) >= it)
       throw std::runtime_error("--stages: '" + item + "' after '" + out.back() +
-                               "' (the order is base, intra, track, inter)");
+                               "' (the order is " + order + ")");
     out.push_back(item);
   }
   if (has(out, "track") && has(out, "inter")) out.erase(std::find(out.begin(), out.end(), "track"));
@@ -66,7 +71,7 @@ std::vector<std::string> parseStages(const std::string& list) {
 }
 
 bool usesPackageDir(const PipelineConfig& c) {
-  // The nodelets' tracker config and the threshold their detector feeds it from (pipelineDetectorThreshold).
+  // The nodelets' tracker config and the threshold their detector feeds it from (params_score_threshold).
   return (c.tracker_config.empty() || c.score_threshold < 0) && has(c.stages, "base") &&
          (has(c.stages, "track") || has(c.stages, "inter"));
 }
@@ -81,12 +86,11 @@ OfflinePipeline::OfflinePipeline(const PipelineConfig& c) : stages_(c.stages) {
         resolveModel(c.detector_model, c.models, "detector.pt", "base", "a detector model", "--detector-model");
     DetectorOptions o = detectorOptionsForModel(path, c.detector_config);
     o.inference.threads = c.threads;
-    if (c.score_threshold >= 0) {
-      o.inference.score_threshold = c.score_threshold;
-    } else if (has(stages_, "track") || has(stages_, "inter")) {  // as the nodelets feed their tracker
-      o.inference.score_threshold =
-          static_cast<float>(pipelineDetectorThreshold(c.package_dir, o.inference.score_threshold));
-    }
+    // As the nodelets feed their tracker: pipeline/score_threshold.h says which source wins.
+    const bool tracks = has(stages_, "track") || has(stages_, "inter");
+    o.inference.score_threshold =
+        chooseScoreThreshold(o.inference.score_threshold, c.params_score_threshold, tracks,
+                             c.score_threshold >= 0 ? std::optional<double>(c.score_threshold) : std::nullopt);
     try {
       if (!c.grid_extent.empty()) o.inference.grid_extent = GridExtent::fromValues(c.grid_extent);
       o.validate();

@@ -4,9 +4,6 @@
 #include <filesystem>
 #include <stdexcept>
 
-#include "ret3d/core/yaml_reader.h"
-#include "ret3d/detector/detector_options.h"
-
 namespace ret3d {
 namespace pipeline {
 
@@ -20,14 +17,6 @@ std::string defaultTrackerConfig(const std::vector<std::string>& stages, const s
   if (!std::filesystem::exists(path))
     throw std::runtime_error(path + ": no such file (the base stage's default tracker config); give --tracker-config FILE");
   return path;
-}
-
-double pipelineDetectorThreshold(const std::string& package_dir, double fallback) {
-  const std::string path = (std::filesystem::path(package_dir) / kPipelineParams).string();
-  if (package_dir.empty() || !std::filesystem::exists(path)) return fallback;
-  double v = fallback;
-  YamlReader::load(path).child("ret3d_detector").get("score_threshold", &v, InferenceOptions::kScoreThreshold);
-  return v;
 }
 
 }  // namespace pipeline

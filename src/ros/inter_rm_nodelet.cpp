@@ -2,8 +2,8 @@
 //
 // InterRM needs each track's past boxes, but as a separate nodelet it only sees the `tracked` messages: the
 // sequences come from pipeline::TrackHistories fed with them (the same class the offline pipeline uses), with the
-// sensor's pose from tf2 as the tracker has it, and histories ageing out after the tracker's max_age (read from the
-// tracker nodelet's parameters, src/ros/params.cpp). Boxes without a track id pass through unrefined; so does the
+// sensor's pose from tf2 as the tracker has it, and histories ageing out after the tracker's max_age (its options read
+// from the tracker nodelet's tracker_config, src/ros/params.cpp). Boxes without a track id pass through unrefined; so does the
 // whole frame if the module refuses it (throttled warning). With ~passthrough (launch inter:=false) no model is loaded
 // and every frame is published unrefined: the stage is off but `objects` still comes out (a remap cannot bridge
 // `tracked` to `objects`, their message types differ). The same objects also go out as vision_msgs/Detection3DArray
@@ -30,14 +30,14 @@ class InterRMNodelet : public StageNodelet<ret3d::DetectionArray> {
  private:
   void setup() override {
     params_ = loadInterRMNodeletParams(getPrivateNodeHandle());
-    if (!params_.max_age_warning.empty()) NODELET_WARN_STREAM(params_.max_age_warning);
+    if (!params_.ignored_warning.empty()) NODELET_WARN_STREAM(params_.ignored_warning);
     if (!params_.passthrough) {
       inter_ = constructStage(getPrivateNodeHandle(), "model_path", params_.inter.model_path,
                               [&] { return std::make_unique<relation::InterRM>(params_.inter); });
     }
     if (inter_) {
       histories_ = std::make_unique<pipeline::TrackHistories>(
-          static_cast<std::size_t>(std::max(1, inter_->arch().max_history)), params_.max_age);
+          static_cast<std::size_t>(std::max(1, inter_->arch().max_history)), params_.tracker.max_age);
     }
     poses_ = std::make_unique<PoseSource>(params_.pose, getNodeHandle());
     publisher_ = getNodeHandle().advertise<ret3d::Object3DArray>("objects", 1);

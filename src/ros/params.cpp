@@ -4,10 +4,13 @@
 #include <ros/names.h>
 #include <ros/package.h>
 
+#include <filesystem>
 #include <sstream>
 #include <yaml-cpp/yaml.h>
 
+#include "ret3d/core/yaml_reader.h"
 #include "ret3d/detector/model_file.h"
+#include "ret3d/pipeline/score_threshold.h"
 
 namespace ret3d {
 namespace {
@@ -166,6 +169,15 @@ std::string packagePath() { return ros::package::getPath("ret3d"); }
 
 std::string defaultModelPath(const std::string& file_name) { return packagePath() + "/models/lwd3d/" + file_name; }
 
+std::optional<double> nodeletParamsScoreThreshold(const std::string& package_dir) {
+  const std::string path = (std::filesystem::path(package_dir) / kNodeletParams).string();
+  if (package_dir.empty() || !std::filesystem::exists(path)) return std::nullopt;
+  double v = 0;
+  if (!YamlReader::load(path).child("ret3d_detector").get("score_threshold", &v, InferenceOptions::kScoreThreshold))
+    return std::nullopt;
+  return v;
+}
+
 StageParams loadStageParams(const ros::NodeHandle& private_nh) {
   const ParamReader p(private_nh);
   StageParams params;
@@ -193,7 +205,12 @@ DetectorNodeletParams loadDetectorNodeletParams(const ros::NodeHandle& private_n
   using I = InferenceOptions;
   InferenceOptions& inf = params.detector.inference;
   inf.threads = p.integer("threads", inf.threads, I::kThreads);
-  inf.score_threshold = static_cast<float>(p.number("score_threshold", inf.score_threshold, I::kScoreThreshold));
+  // ~score_threshold: config/ret3d.yaml's value, or the launch file's / command line's (pipeline/score_threshold.h).
+  const std::optional<double> score_threshold =
+      p.has("score_threshold") ? std::optional<double>(p.number("score_threshold", 0, I::kScoreThreshold))
+                               : std::nullopt;
+  inf.score_threshold =
+      pipeline::chooseScoreThreshold(inf.score_threshold, score_threshold, /*tracks=*/true, std::nullopt);
   inf.candidate_threshold =
       static_cast<float>(p.number("candidate_threshold", inf.candidate_threshold, I::kCandidateThreshold));
   inf.nms_iou = p.number("nms_iou", inf.nms_iou, I::kNmsIou);
@@ -277,19 +294,17 @@ InterRMNodeletParams loadInterRMNodeletParams(const ros::NodeHandle& private_nh)
   params.inter.threads = p.integer("threads", 2, 1, 64);
   params.pose = loadPoseParams(p);
   if (params.passthrough) return params;  // no histories kept
-  // The tracker's own configuration, read as the tracker nodelet reads it (one home for max_age).
+  // The tracker's own options, from its tracker_config (or inline ~tracker) read as the tracker nodelet reads them:
+  // the one home of max_age.
   const std::string tracker_node = p.nonEmpty("tracker_node", "ret3d_tracker");
   const ros::NodeHandle tracker_nh(ros::NodeHandle(ros::names::parentNamespace(private_nh.getNamespace())),
                                    tracker_node);
-  const int tracker_max_age = loadTrackerNodeletParams(tracker_nh).tracker.max_age;
-  params.max_age = p.integer("max_age", tracker_max_age, 0, 1000);
-  if (params.max_age != tracker_max_age) {
-    params.max_age_warning = "parameter " + p.fullName("max_age") + " = " + std::to_string(params.max_age) +
-                             " differs from the tracker's max_age " + std::to_string(tracker_max_age) + " (" +
-                             tracker_nh.getNamespace() + "): track histories " +
-                             (params.max_age < tracker_max_age ? "of coasting tracks are dropped before they end"
-                                                               : "are kept longer than their tracks") +
-                             "; remove ~max_age to follow the tracker";
+  params.tracker = loadTrackerNodeletParams(tracker_nh).tracker;
+  if (p.has("max_age")) {
+    params.ignored_warning = "parameter " + p.fullName("max_age") + " is no longer read (ignored): track histories " +
+                             "follow the tracker's max_age " + std::to_string(params.tracker.max_age) + " (" +
+                             tracker_nh.resolveName("tracker_config") + " or " + tracker_nh.resolveName("tracker") +
+                             "); remove it";
   }
   return params;
 }

@@ -41,6 +41,7 @@
 #include "ret3d/Object3DArray.h"
 #include "ret3d/core/json_writer.h"
 #include "ret3d/core/stats.h"
+#include "ret3d/pipeline/stage_layout.h"
 #include "ret3d/ros/bag_reader.h"
 #include "ret3d/ros/diagnostics.h"
 #include "ret3d/ros/params.h"
@@ -477,7 +478,8 @@ struct Stage {
   std::string name;      // key in the table and the JSON (as `ret3d bench --data`)
   std::string nodelet;   // node name, as launch/ret3d.launch
   std::string type;      // plugin
-  std::string input, output;
+  std::string input, output;                  // absolute topics, after the remaps
+  std::map<std::string, std::string> remaps;  // relative topic names, from -> to
 };
 
 struct Row {
@@ -790,15 +792,20 @@ bool hasStage(const std::vector<Stage>& stages, const std::string& name) {
   return std::any_of(stages.begin(), stages.end(), [&](const Stage& s) { return s.name == name; });
 }
 
-// The nodelets of --stages in pipeline order; InterRM brings the tracker it reads from.
+// The nodelets of --stages in pipeline order, as launch/ret3d.launch loads them (the one stage table,
+// pipeline/stage_layout.h) with the stages after the last one left out; InterRM brings the tracker it reads from.
+// The markers are not a stage here (loadNodelets adds them).
 std::vector<Stage> pipelineStages(const NodeletBenchOptions& o) {
-  auto has = [&](const char* s) { return std::find(o.stages.begin(), o.stages.end(), s) != o.stages.end(); };
-  const bool intra = has("intra"), inter = has("inter"), tracker = has("track") || inter;
-  std::vector<Stage> stages = {{"base", "ret3d_detector", "ret3d/DetectorNodelet", kPoints, "/detections"}};
-  if (intra) stages.push_back({"intra", "ret3d_intra", "ret3d/IntraRMNodelet", "/detections", "/detections_intra"});
-  if (tracker)
-    stages.push_back({"track", "ret3d_tracker", "ret3d/TrackerNodelet", stages.back().output, "/tracked"});
-  if (inter) stages.push_back({"inter", "ret3d_inter", "ret3d/InterRMNodelet", "/tracked", "/objects"});
+  auto has = [&](const std::string& s) { return std::find(o.stages.begin(), o.stages.end(), s) != o.stages.end(); };
+  std::map<std::string, bool> switches;
+  for (const pipeline::StageLayout& s : pipeline::pipelineLayout())
+    if (s.off == pipeline::WhenOff::Bridged) switches[s.switch_arg] = has(s.offline);
+  std::vector<Stage> stages;
+  for (const pipeline::NodeletLoad& n : pipeline::nodeletsToLoad(switches)) {
+    const pipeline::StageLayout& s = *n.stage;
+    if (s.offline.empty() || !(has(s.offline) || (s.offline == "track" && has("inter")))) continue;
+    stages.push_back({s.offline, s.node, s.nodelet, "/" + n.input(), "/" + s.output, n.remaps});
+  }
   return stages;
 }
 
@@ -850,21 +857,21 @@ void setNodeletParams(const NodeletBenchOptions& o, const std::string& params) {
 }
 
 void loadNodelets(nodelet::Loader& loader, const std::vector<Stage>& stages, const NodeletBenchOptions& o) {
-  const bool intra = hasStage(stages, "intra"), inter = hasStage(stages, "inter");
   std::cout << "bench: loading the nodelets into this process (the manager, " << o.manager_threads
             << " callback threads):";
-  std::vector<std::pair<std::string, std::string>> load;
-  for (const Stage& s : stages) load.emplace_back(s.nodelet, s.type);
-  const bool markers = o.markers && inter;
-  if (markers) load.emplace_back("ret3d_markers", "ret3d/MarkerNodelet");
-  for (const auto& [name, type] : load) std::cout << " " << type;
+  std::vector<Stage> load = stages;
+  // The markers read InterRM's objects, as the launch file loads them.
+  const auto& layout = pipeline::pipelineLayout();
+  const auto markers = std::find_if(layout.begin(), layout.end(), [](const auto& s) { return s.offline.empty(); });
+  if (o.markers && hasStage(stages, "inter")) load.push_back({"", markers->node, markers->nodelet, "", "", {}});
+  for (const Stage& s : load) std::cout << " " << s.type;
   std::cout << std::endl;
-  for (const auto& [name, type] : load) {
+  for (const Stage& s : load) {
     ros::M_string remap;
-    // Without IntraRM the tracker reads the detector's output, as launch/ret3d.launch remaps it with intra:=false.
-    if (name == "ret3d_tracker" && !intra) remap["/detections_intra"] = "/detections";
-    if (!loader.load("/" + name, type, remap, {}))
-      throw std::runtime_error("nodelet " + name + " (" + type + ") did not start; see the message above");
+    // A stage left out is bridged as launch/ret3d.launch bridges it (intra:=false: the tracker reads detections).
+    for (const auto& [from, to] : s.remaps) remap["/" + from] = "/" + to;
+    if (!loader.load("/" + s.nodelet, s.type, remap, {}))
+      throw std::runtime_error("nodelet " + s.nodelet + " (" + s.type + ") did not start; see the message above");
   }
 }
 
@@ -1082,7 +1089,7 @@ BusyLoad::~BusyLoad() {
 int runNodeletBench(const NodeletBenchOptions& o, NodeletBenchResult* result) {
   checkOptions(o);
   const std::vector<Stage> stages = pipelineStages(o);
-  const std::string params = o.params.empty() ? packagePath() + "/config/ret3d.yaml" : o.params;
+  const std::string params = o.params.empty() ? packagePath() + "/" + kNodeletParams : o.params;
   if (packagePath().empty() && (o.params.empty() || o.tracker_config.empty()))
     throw std::runtime_error("the ret3d package is not on ROS_PACKAGE_PATH (`source scripts/env.sh`), so its "
                              "config/ret3d.yaml cannot be found; or give --params FILE");

@@ -20,7 +20,9 @@ void addScoreThresholdOption(CLI::App& app, double* threshold) {
 }
 
 pipeline::PipelineConfig withPackageDir(pipeline::PipelineConfig config) {
-  if (pipeline::usesPackageDir(config)) config.package_dir = packagePath();
+  if (!pipeline::usesPackageDir(config)) return config;
+  config.package_dir = packagePath();
+  config.params_score_threshold = nodeletParamsScoreThreshold(config.package_dir);
   return config;
 }
 

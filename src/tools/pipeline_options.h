@@ -17,7 +17,8 @@ void addGridExtentOption(CLI::App& app, std::vector<double>* extent);
 // The --score-threshold option of the commands that run the pipeline (PipelineConfig::score_threshold).
 void addScoreThresholdOption(CLI::App& app, double* threshold);
 
-// `config` with the package folder filled in when the pipeline needs it (pipeline::usesPackageDir). Only then: the
+// `config` with the package folder, and the threshold the nodelets' parameter file gives the detector
+// (nodeletParamsScoreThreshold), filled in when the pipeline needs them (pipeline::usesPackageDir). Only then: the
 // look-up asks rospack, which complains on stderr when the package is not on ROS_PACKAGE_PATH.
 pipeline::PipelineConfig withPackageDir(pipeline::PipelineConfig config);
 

@@ -52,22 +52,6 @@ TEST(TrackerDefault, AMissingPackageIsAClearError) {
   }
 }
 
-// The detector feeds the tracker from config/ret3d.yaml's threshold offline as online; the model's own without it.
-TEST(TrackerDefault, TheDetectorFeedsTheTrackerFromTheNodeletsThreshold) {
-  const double online = pipelineDetectorThreshold(kPackage, 0.9);
-  EXPECT_GT(online, 0.0);
-  EXPECT_LT(online, 0.9);  // read from the file, not the fallback
-  test::TempDir tmp;
-  EXPECT_DOUBLE_EQ(pipelineDetectorThreshold(tmp.path(), 0.5), 0.5);  // no config/ret3d.yaml
-  EXPECT_DOUBLE_EQ(pipelineDetectorThreshold("", 0.5), 0.5);
-  std::filesystem::create_directories(tmp / "config");
-  std::ofstream(tmp / "config/ret3d.yaml") << "ret3d_detector:\n  nms_iou: 0.1\n";
-  EXPECT_DOUBLE_EQ(pipelineDetectorThreshold(tmp.path(), 0.5), 0.5);  // no key
-  std::ofstream(tmp / "config/ret3d.yaml") << "ret3d_detector:\n  score_threshold: 1.5\n";
-  const std::string msg = test::errorMessage([&] { pipelineDetectorThreshold(tmp.path(), 0.5); });
-  EXPECT_NE(msg.find("score_threshold"), std::string::npos) << msg;
-}
-
 }  // namespace
 }  // namespace pipeline
 }  // namespace ret3d

@@ -383,8 +383,8 @@ TEST_F(PipelineStart, InterRMReadsTheTrackersOptions) {
   expectRefusal("ret3d/InterRMNodelet", {"/bad_tracker/tracker", "max_age", "-3"});
 }
 
-// A ~max_age left over from older parameter files still applies, but a value other than the tracker's is said.
-TEST_F(PipelineStart, InterRMWarnsWhenItsMaxAgeDiffersFromTheTrackers) {
+// A ~max_age left over from older parameter files is ignored, and the warning says whose max_age applies.
+TEST_F(PipelineStart, InterRMIgnoresItsOwnMaxAgeAndSaysSo) {
   relation::InterRMArch arch;
   arch.c_enc = 32;
   arch.heads = 4;
@@ -397,7 +397,7 @@ TEST_F(PipelineStart, InterRMWarnsWhenItsMaxAgeDiffersFromTheTrackers) {
   ros::param::set("/bad/max_age", 9);
   nodelet::Loader loader(false);
   ASSERT_TRUE(test::loadNodelet(loader, "/bad", "ret3d/InterRMNodelet")) << log_.all();
-  EXPECT_FALSE(log_.find({"/bad/max_age = 9", "differs from the tracker's max_age 4", "/bad_tracker"}).empty())
+  EXPECT_FALSE(log_.find({"/bad/max_age", "ignored", "the tracker's max_age 4", "/bad_tracker/tracker_config"}).empty())
       << log_.all();
 }
 

@@ -6,6 +6,7 @@
 
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,13 +30,16 @@ struct PipelineConfig {
   std::string tracker_config;       // tracker YAML; empty: defaultTrackerConfig(stages, package_dir)
   std::string package_dir;          // the ret3d package folder; only read when usesPackageDir(config)
   double score_threshold = -1;      // >= 0: overrides the detector's inference.score_threshold
+  // The nodelets' parameter file's detector threshold (config/ret3d.yaml, ret3d_detector/score_threshold), read by the
+  // caller when usesPackageDir(config); applies when the pipeline tracks (pipeline/score_threshold.h). nullopt: none.
+  std::optional<double> params_score_threshold;
   std::vector<double> grid_extent;  // non-empty: overrides inference.grid_extent [x_min, x_max, y_min, y_max]
   int threads = 2;
 };
 
-// True when the pipeline needs config.package_dir: the base stage tracks, without --tracker-config (the nodelets'
-// tracker config) or without --score-threshold (the threshold the nodelets' detector feeds their tracker from;
-// pipeline/tracker_default.h).
+// True when the pipeline needs config.package_dir (and params_score_threshold): the base stage tracks, without
+// --tracker-config (the nodelets' tracker config) or without --score-threshold (the threshold the nodelets' detector
+// feeds their tracker from; pipeline/score_threshold.h).
 bool usesPackageDir(const PipelineConfig& config);
 
 // Parses "base,intra,track" (or "none"): throws naming an unknown stage or a misplaced one.

@@ -8,7 +8,8 @@
 namespace ret3d {
 namespace pipeline {
 
-// The tracker YAML of the LWD-3D pipeline, relative to the package (config/ret3d.yaml names it for the nodelets).
+// The tracker YAML of the LWD-3D pipeline, relative to the package (config/ret3d.yaml names it for the nodelets): the
+// one constant for that path outside the parameter file.
 inline constexpr const char* kPipelineTrackerConfig = "config/tracker_lwd3d_pipeline.yaml";
 
 // With the base stage (the LWD-3D detector, whose scores are probabilities): <package_dir>/kPipelineTrackerConfig,
@@ -16,14 +17,6 @@ inline constexpr const char* kPipelineTrackerConfig = "config/tracker_lwd3d_pipe
 // which are tuned for those. Throws, saying what to do, when the base stage needs the file and package_dir is empty
 // (the package is not on ROS_PACKAGE_PATH) or the file is missing.
 std::string defaultTrackerConfig(const std::vector<std::string>& stages, const std::string& package_dir);
-
-// The nodelets' parameter file, relative to the package.
-inline constexpr const char* kPipelineParams = "config/ret3d.yaml";
-
-// The score from which the detector publishes its boxes to the tracker in the pipeline: kPipelineParams'
-// ret3d_detector/score_threshold (lower than the model's own published threshold: the tracker continues its tracks
-// through weak detections and starts them only from its birth scores). `fallback` when the file or key is absent.
-double pipelineDetectorThreshold(const std::string& package_dir, double fallback);
 
 }  // namespace pipeline
 }  // namespace ret3d

@@ -7,6 +7,7 @@
 #include <ros/node_handle.h>
 #include <xmlrpcpp/XmlRpcValue.h>
 
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -61,6 +62,13 @@ std::string packagePath();
 // Default model files: $(find ret3d)/models/lwd3d/{detector,intra_rm,inter_rm}.pt.
 std::string defaultModelPath(const std::string& file_name);
 
+// The nodelets' parameter file (one section per node name), relative to the package.
+inline constexpr const char* kNodeletParams = "config/ret3d.yaml";
+// Its ret3d_detector/score_threshold in the package at `package_dir` (checked against InferenceOptions'
+// range), for the offline pipeline (pipeline::PipelineConfig::params_score_threshold); nullopt without the file or
+// the key. The same value the launch file gives the detector nodelet as ~score_threshold.
+std::optional<double> nodeletParamsScoreThreshold(const std::string& package_dir);
+
 // What every stage that needs the sensor's pose shares.
 struct PoseParams {
   std::string fixed_frame = "odom";
@@ -99,12 +107,12 @@ struct InterRMNodeletParams {
   // ~publish_detections: the objects also as vision_msgs/Detection3DArray on objects/detections (ros/detection3d.h)
   bool publish_detections = true;
   PoseParams pose;
-  // Histories of track ids not seen for more than this many frames are dropped: the tracker's max_age, read from the
-  // tracker nodelet's own parameters (~tracker_node, default "ret3d_tracker", a sibling of this nodelet), since a
-  // track that coasts longer than that never comes back with the same id. ~max_age, when set, overrides it (kept for
-  // older parameter files; a warning when it differs from the tracker's).
-  int max_age = TrackerOptions().max_age;
-  std::string max_age_warning;       // non-empty: ~max_age disagrees with the tracker's (the nodelet logs it)
+  // The tracker's options, from the tracker nodelet's own parameters (its tracker_config or inline tracker; the
+  // nodelet named by ~tracker_node, default "ret3d_tracker", a sibling of this one): histories of track ids not seen
+  // for more than tracker.max_age frames are dropped, since a track that coasts longer never comes back with that id.
+  TrackerOptions tracker;
+  // Non-empty: ~max_age is set, which is no longer read (the nodelet logs this warning).
+  std::string ignored_warning;
 };
 struct MarkerNodeletParams {
   MarkerOptions markers;
@@ -115,7 +123,7 @@ StageParams loadStageParams(const ros::NodeHandle& private_nh);
 DetectorNodeletParams loadDetectorNodeletParams(const ros::NodeHandle& private_nh);
 IntraRMNodeletParams loadIntraRMNodeletParams(const ros::NodeHandle& private_nh);
 TrackerNodeletParams loadTrackerNodeletParams(const ros::NodeHandle& private_nh);
-// Reads the tracker's max_age from the tracker nodelet's parameters with loadTrackerNodeletParams (its namespace:
+// Reads the tracker's options from the tracker nodelet's parameters with loadTrackerNodeletParams (its namespace:
 // ~tracker_node resolved in private_nh's parent namespace).
 InterRMNodeletParams loadInterRMNodeletParams(const ros::NodeHandle& private_nh);
 MarkerNodeletParams loadMarkerNodeletParams(const ros::NodeHandle& private_nh);
