@@ -158,6 +158,15 @@ void refineBoxes(const PointCloud& cloud, const InferenceOptions& o, std::vector
   headingFromVelocity(boxes, o.heading_from_velocity);
 }
 
+// Calibrated classes were let in below score_threshold (candidate_threshold): their final scores decide. Nothing
+// stands inside or against the vehicle's own body (ego, when set).
+void dropLowOrOnEgo(float min_score, const EgoBox* ego, const Eigen::Isometry3d& sensor_to_base, std::vector<Box>* boxes) {
+  auto low = [&](const Box& b) {
+    return b.score < min_score || (ego && ego->touches(b, sensor_to_base, InferenceOptions::kEgoMargin));
+  };
+  boxes->erase(std::remove_if(boxes->begin(), boxes->end(), low), boxes->end());
+}
+
 // The near and far fields' boxes after NMS into one list: the near model's boxes inside its share, the far model's
 // outside it except those overlapping a near box of their class across the boundary (they yield to it, as NMS would
 // have it). Each model went through NMS and voting on its own, so inside the near field the boxes are the near
@@ -262,14 +271,8 @@ Detections Detector::detect(const PointCloud& current_in, const PointCloud* prev
   // Each box refined and scored by its own model's options.
   refineBoxes(current, o, &det.boxes);
   if (!far_boxes.empty()) refineBoxes(current, im.far_inference, &far_boxes);
-  // Calibrated classes were let in below score_threshold (candidate_threshold): their final scores decide.
-  const float min_score = o.score_threshold;
-  // Nothing stands inside or against the vehicle's own body.
-  auto low = [&](const Box& b) {
-    return b.score < min_score || (ego && ego->touches(b, im.sensor_to_base, InferenceOptions::kEgoMargin));
-  };
-  det.boxes.erase(std::remove_if(det.boxes.begin(), det.boxes.end(), low), det.boxes.end());
-  far_boxes.erase(std::remove_if(far_boxes.begin(), far_boxes.end(), low), far_boxes.end());
+  dropLowOrOnEgo(o.score_threshold, ego ? &*ego : nullptr, im.sensor_to_base, &det.boxes);
+  dropLowOrOnEgo(o.score_threshold, ego ? &*ego : nullptr, im.sensor_to_base, &far_boxes);
   timings_.refine_ms = msSince(t0);
 
   // The features o_i belong to decoding (Ret3D §3.1): timed with it. Each box's from its own model's map; the boxes
