@@ -24,8 +24,8 @@ PACKAGES=(
   libdiagnostic-updater-dev libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
   # checks, plots, visual tests; clang with libFuzzer for the fuzz targets (scripts/fuzz.sh)
   catkin-lint gnuplot-nox imagemagick rviz xvfb clang libclang-rt-14-dev
-  # model-building scripts (scripts/fit_score_calibration.py)
-  python3-numpy
+  # model-building scripts (scripts/fit_score_calibration.py; calibration_config.py reads `base:` chains)
+  python3-numpy python3-yaml
 )
 
 missing=()

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The soak (issue 21): a bag replayed in a loop through the nodelets (`ret3d bench --bag BAG --loop-frames N`, one
+# The soak: a bag replayed in a loop through the nodelets (`ret3d bench --bag BAG --loop-frames N`, one
 # manager process, at the bag's rate) with the manager's resident memory, open file descriptors, threads and the
 # latencies sampled every --every clouds; then the plot of the samples (gnuplot, as scripts/experiments/sim_realism.sh)
 # and the acceptance checks: memory from frame 1000 to the end grows by < 5 %, the descriptor count stays the same, the

@@ -10,21 +10,21 @@
 #      and a third (lwd3d_<head>_stage3.yaml, 6 more epochs at half the rate), each kept when it validates better;
 #      the best is installed as models/lwd3d/detector.pt. The inference options (box voting, IoU-score power, point
 #      refinement) were chosen on the tuning set and are written in the last stage's YAML;
-#   5. (session 10) fine-tunes the result 4 epochs with sim-to-real augmentation and ground-truth sampling
+#   5. fine-tunes the result 4 epochs with sim-to-real augmentation and ground-truth sampling
 #      (config/detector/lwd3d_<head>_robust.yaml), kept when it validates better;
-#   6. (sessions 11 and 12; needs ../shared/data or RET3D_SHARED_DATA, skipped with a message without it) two rounds
+#   6. (needs ../shared/data or RET3D_SHARED_DATA, skipped with a message without it) two rounds
 #      of 2 epochs each with the 37 unlabelled real KITTI scans taught as background
 #      (config/detector/lwd3d_anchor_selftrain.yaml, `scripts/real_negatives.py` labelling them from the previous
-#      round's detector); (session 13) two more epochs on data made again by the simulator whose pedestrians have a
+#      round's detector); then two more epochs on data made again by the simulator whose pedestrians have a
 #      realistic build (data/sim4_*); refits the car, pedestrian and cyclist score calibration on that simulator's
 #      relation set (`scripts/fit_score_calibration.py`) and installs the result with that calibration;
 #   7. trains IntraRM and InterRM behind the installed detector on the relation set and installs them.
-# The data folders are named for the simulator that made them (data/sim3_*: session 12's, whose pedestrian labels
+# The data folders are named for the simulator that made them (data/sim3_*: the third generation, whose pedestrian labels
 # have KITTI's proportions); a folder made by an older simulator is not reused.
 # Resumable: run it again after a stop and it continues from the last checkpoint (every 5 minutes); finished steps
 # are skipped. On the idle 2-core machine about 55 minutes for the two heads, 40 for the second stage and 20 for the
 # third (112 in all; on a host slowed by other load, up to twice that), then about 30 for steps 5-7 (its first
-# end-to-end run, sessions 12-14 on a shared host: about 3.5 hours in all). Work goes to data/ and
+# end-to-end run, on a shared host: about 3.5 hours in all). Work goes to data/ and
 # out/train_default/. The figures of a reproduction belong in models/lwd3d/MODEL_CARD.md (the first run's are there).
 set -eo pipefail
 cd "$(dirname "$0")/.."
@@ -105,7 +105,7 @@ stage() {  # stage-name init-model [extra ret3d train detector options]
 best_head=$best
 stage stage2 "$OUT/$best_head.pt"
 [ -f "$OUT/${best_head}_stage2.pt" ] && stage stage3 "$OUT/${best_head}_stage2.pt"
-# Session 10: a sim-to-real fine-tune (config/detector/lwd3d_<head>_robust.yaml: 4 epochs with ray drop, beam
+# A sim-to-real fine-tune (config/detector/lwd3d_<head>_robust.yaml: 4 epochs with ray drop, beam
 # subsampling, intensity changes, previous-sweep dropout, pose jitter and ground-truth sampling from a database of
 # the training sets' objects; models/lwd3d/MODEL_CARD.md). Its score calibration was refitted afterwards on the
 # relation set (scripts/fit_score_calibration.py) and written into that YAML.
@@ -113,13 +113,13 @@ if [ -f "config/detector/lwd3d_${best_head}_robust.yaml" ] && [ -f "$OUT/${best_
   [ -f data/gtdb/sim3_train.gtdb ] || ret3d train gtdb --data data/sim3_train_urban data/sim3_train_highway \
     --config "config/detector/lwd3d_${best_head}_robust.yaml" --out data/gtdb/sim3_train.gtdb >"$OUT/gtdb.log" 2>&1
   stage robust "$OUT/${best_head}_stage3.pt" --gt-database data/gtdb/sim3_train.gtdb
-  # Kept whatever the simulated validation says, as session 10 kept it: it is made for real scans (its reproduction
-  # validated 68.99 against stage 3's 72.38 on data/sim3_val_urban; session 10 chose it on the real frames).
+  # Kept whatever the simulated validation says: it is made for real scans (its reproduction validated 68.99
+  # against stage 3's 72.38 on data/sim3_val_urban; it was chosen on the real frames).
   model="$OUT/${best_head}_robust.pt"
   best="$best_head head, robust"
 fi
 
-# Sessions 11-12: the real scans as background, two rounds. Each round labels the 37 unlabelled real scans from the
+# The real scans as background, two rounds. Each round labels the 37 unlabelled real scans from the
 # previous detector's boxes at score >= 0.05 (a pedestrian or cyclist box embedded in structure stays background,
 # every other box scoring >= 0.1 becomes DontCare; scripts/real_negatives.py) and trains 2 epochs from its weights.
 DATA_DIR=${RET3D_SHARED_DATA:-$ROOT/../shared/data}
@@ -152,7 +152,7 @@ selftrain() {  # round init-model
   model="$OUT/$name.pt"
   echo "real-background round $1: $(tail -n 1 "$OUT/${name}_labels.log"); model $model"
 }
-# Session 13: two more epochs from round 2's weights on data made again by the simulator whose pedestrians have a
+# Two more epochs from round 2's weights on data made again by the simulator whose pedestrians have a
 # realistic build (data/sim4_*: same seeds, shoulders 0.48 m across the arms, chests 0.28 m deep, some backpacks),
 # with round 2's real-scan labels.
 SIM4_TRAIN=(--data data/sim4_train_urban data/sim4_train_highway data/real_unl_round2 --data-weights 1 1 12
@@ -249,7 +249,7 @@ echo "default detector: $model ($best; validation mean 3D AP R40 moderate $best_
 
 # IntraRM and InterRM behind the installed detector, on the relation set (sequences 0-9 train, 10-11 validation),
 # taught on the boxes it scores >= 0.3 (more than the 0.5 it publishes: on the simulated validation set, whole
-# pipeline, L2 mAPH 36.35 against 36.07 for the modules trained behind the previous weights; session 13).
+# pipeline, L2 mAPH 36.35 against 36.07 for the modules trained behind the previous weights).
 REL=data/sim3_relation_urban
 [ -d data/sim4_relation_urban ] && REL=data/sim4_relation_urban
 if [ ! -f "$OUT/relation_$(basename $REL).done" ]; then

@@ -17,7 +17,7 @@ source scripts/env.sh
 set -u
 source scripts/simulate_once.sh
 # HELDOUT_SEED picks another held-out set (data/sim_test_urban_<seed>): the seed fixes a scene's layout and traffic,
-# so a set whose seeds were looked at many times stays familiar even after the simulator changes (session 10: 9100).
+# so a set whose seeds were looked at many times stays familiar even after the simulator changes (9100 was the seed of the first one).
 # EVAL_DATA evaluates an existing dataset instead (e.g. the validation set data/sim4_val_urban), the same way.
 HELDOUT_SEED=${HELDOUT_SEED:-9000}
 DATA=data/sim_test_urban

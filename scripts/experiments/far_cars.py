@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""How many returns the simulated cars have at each range, and which of them a prediction finds (issue 20: can any
+"""How many returns the simulated cars have at each range, and which of them a prediction finds (can any
 detector reach Car MOTA 75 over the labels' 80 m?). For every car label of a KITTI tracking folder: its range, the
 LiDAR returns inside its box (grown by 0.1 m) in the sensor frame, and whether a predicted car of the same frame lies
 within 2 m of its centre (each prediction folder given). Prints recall per range band and per return count.

@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
-# The two-resolution detector of issue 20 (docs/RESULTS.md, "Long range: a near field and a far field"): the default
+# The two-resolution detector (docs/RESULTS.md, "Long range: a near field and a far field"): the default
 # model keeps its 0.25 m cells over a near field, and a second network on 0.5 m cells over x +-80, y +-48 m gives the
 # boxes outside it (inference.far_field). The far network starts from models/lwd3d's weights
 # (config/detector/lwd3d_anchor_far.yaml), then its score calibration is refitted, both are put in one folder
 # (`ret3d train far-field`), IntraRM / InterRM are trained behind the pair, and the validation table, the six real
 # frames and the cost are measured against the default. Resumable: every step leaves a marker in OUT.
 #   scripts/experiments/far_field.sh
-# Needs data/sim5_* (the session-15 simulator; scripts/train_default.sh's commands with data/sim5_ names),
+# Needs data/sim5_* (the fifth generation of the simulator; scripts/train_default.sh's commands with data/sim5_ names),
 # data/real_unl_long (scripts/experiments/long_range.sh makes it) and the real scans (RET3D_SHARED_DATA).
 # Environment: OUT (default out/far), NEAR (the near field, default -40,40,-24,24), RET3D_BIN (the binary that trains,
 # default ret3d: a copy lets the tree be rebuilt meanwhile).

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""What IntraRM's radius graph has to work with (issue 23): over a `ret3d detect` result and its labels, how many
+"""What IntraRM's radius graph has to work with: over a `ret3d detect` result and its labels, how many
 neighbours a detected box has within each radius (IntraRM links boxes whose BEV centres are closer than r), and how
 far the detected boxes are from the objects they found (centre error, heading error), per class.
 

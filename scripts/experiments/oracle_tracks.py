@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""What Car MOTA a detector that sees only cars with enough returns could reach at best (issue 20's bar of 75 over
+"""What Car MOTA a detector that sees only cars with enough returns could reach at best (the bar of 75 over
 the labels' 80 m). Writes, for each minimum return count K, a KITTI tracking result folder holding exactly the car
 labels whose box (grown by 0.1 m) holds at least K LiDAR returns, with their true track ids and score 1: a perfect
 detector and tracker for those cars, and blind to the others. `ret3d eval --metric mot` on each gives the bound.

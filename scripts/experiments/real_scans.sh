@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The base detector on real KITTI scans (issue 5, "on real scans, reported honestly"): `ret3d detect` over the four
+# The base detector on real KITTI scans ("on real scans, reported honestly"): `ret3d detect` over the four
 # labelled KITTI object frames of ../shared/data, `ret3d eval` (KITTI AP) on them, and bird's-eye-view pictures with
 # `ret3d draw`: docs/real_<frame>.png (ground truth white, detections by class) for the four labelled frames and
 # docs/real_unlabeled_<n>.png for three unlabeled scans. The data is read in place, never copied.

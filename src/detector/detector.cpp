@@ -39,6 +39,10 @@ struct Detector::Impl {
 
   void loadFarField(const DetectorOptions& options);
   void setFarInference(const InferenceOptions& near);
+  // The current sweep without the vehicle's own returns (ego: inference.ego_box), and previous pointed at the
+  // previous one's (in its own sensor frame); the sweeps as given without an ego box.
+  const PointCloud& outsideEgoBox(const std::optional<EgoBox>& ego, const PointCloud& current_in,
+                                  const PointCloud*& previous);
 };
 
 namespace {
@@ -126,20 +130,96 @@ std::string Detector::describeGrids() const {
 }
 nn::DetectorModel& Detector::model() { return *impl_->model; }
 
+namespace {
+
+// One model's candidates through rotated NMS, then box voting when nms_voting_iou is set.
+std::vector<Box> suppress(const std::vector<Box>& c, const InferenceOptions& o) {
+  const auto keep = rotatedNms(c, o.nms_iou, true, static_cast<std::size_t>(std::max(0, o.max_detections)));
+  if (o.nms_voting_iou > 0) return voteBoxes(c, keep, o.nms_voting_iou);
+  std::vector<Box> kept;
+  kept.reserve(keep.size());
+  for (std::size_t i : keep) kept.push_back(c[i]);
+  return kept;
+}
+
+// With a far field the near model owns the boxes centred inside its grid shrunk by the margin, the far model every
+// other one.
+struct NearFieldShare {
+  const BevGeometry& g;
+  double margin;
+  bool owns(const Box& b) const {
+    return b.x >= g.x_min + margin && b.x < g.x_max - margin && b.y >= g.y_min + margin && b.y < g.y_max - margin;
+  }
+};
+
+// Point refinement and heading from velocity with one model's options.
+void refineBoxes(const PointCloud& cloud, const InferenceOptions& o, std::vector<Box>* boxes) {
+  if (o.point_refine.enabled()) refineBoxesFromPoints(cloud, boxes, o.point_refine);
+  headingFromVelocity(boxes, o.heading_from_velocity);
+}
+
+// Calibrated classes were let in below score_threshold (candidate_threshold): their final scores decide. Nothing
+// stands inside or against the vehicle's own body (ego, when set).
+void dropLowOrOnEgo(float min_score, const EgoBox* ego, const Eigen::Isometry3d& sensor_to_base, std::vector<Box>* boxes) {
+  auto low = [&](const Box& b) {
+    return b.score < min_score || (ego && ego->touches(b, sensor_to_base, InferenceOptions::kEgoMargin));
+  };
+  boxes->erase(std::remove_if(boxes->begin(), boxes->end(), low), boxes->end());
+}
+
+// The near and far fields' boxes after NMS into one list: the near model's boxes inside its share, the far model's
+// outside it except those overlapping a near box of their class across the boundary (they yield to it, as NMS would
+// have it). Each model went through NMS and voting on its own, so inside the near field the boxes are the near
+// model's as if it ran alone.
+void mergeFields(const NearFieldShare& near_share, double nms_iou, std::vector<Box>* near, std::vector<Box>* far) {
+  near->erase(std::remove_if(near->begin(), near->end(), [&](const Box& b) { return !near_share.owns(b); }),
+              near->end());
+  far->erase(std::remove_if(far->begin(), far->end(),
+                            [&](const Box& f) {
+                              return std::any_of(near->begin(), near->end(), [&](const Box& n) {
+                                return n.label == f.label && bevIoU(n, f) > nms_iou;
+                              });
+                            }),
+             far->end());
+}
+
+// The far field's boxes and feature rows appended to the near field's, all then in descending score.
+void appendFarField(const std::vector<Box>& far_boxes, const torch::Tensor& far_features, std::vector<Box>* boxes,
+                    torch::Tensor* features) {
+  *features = torch::cat({*features, far_features}, 0);
+  boxes->insert(boxes->end(), far_boxes.begin(), far_boxes.end());
+  std::vector<std::int64_t> order(boxes->size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::int64_t a, std::int64_t b) { return (*boxes)[a].score > (*boxes)[b].score; });
+  std::vector<Box> sorted;
+  sorted.reserve(order.size());
+  for (std::int64_t i : order) sorted.push_back((*boxes)[i]);
+  *boxes = std::move(sorted);
+  *features = features->index_select(0, torch::tensor(order, torch::kLong)).contiguous();
+}
+
+}  // namespace
+
+const PointCloud& Detector::Impl::outsideEgoBox(const std::optional<EgoBox>& ego, const PointCloud& current_in,
+                                                const PointCloud*& previous) {
+  if (!ego) return current_in;
+  current_outside = current_in;
+  removePointsInside(*ego, sensor_to_base, &current_outside);
+  if (previous) {
+    previous_outside = *previous;
+    removePointsInside(*ego, sensor_to_base, &previous_outside);
+    previous = &previous_outside;
+  }
+  return current_outside;
+}
+
 Detections Detector::detect(const PointCloud& current_in, const PointCloud* previous_in,
                             const Eigen::Isometry3d& prev_to_current) {
   Impl& im = *impl_;
   const std::optional<EgoBox>& ego = options_.inference.ego_box;
-  if (ego) {  // the vehicle's own returns out of both sweeps (the previous one in its own sensor frame)
-    im.current_outside = current_in;
-    removePointsInside(*ego, im.sensor_to_base, &im.current_outside);
-    if (previous_in) {
-      im.previous_outside = *previous_in;
-      removePointsInside(*ego, im.sensor_to_base, &im.previous_outside);
-    }
-  }
-  const PointCloud& current = ego ? im.current_outside : current_in;
-  const PointCloud* previous = ego && previous_in ? &im.previous_outside : previous_in;
+  const PointCloud* previous = previous_in;
+  const PointCloud& current = im.outsideEgoBox(ego, current_in, previous);
   const bool far = im.far_model != nullptr;
   auto t0 = std::chrono::steady_clock::now();
   if (far)
@@ -165,86 +245,45 @@ Detections Detector::detect(const PointCloud& current_in, const PointCloud* prev
 
   t0 = std::chrono::steady_clock::now();
   const BevGeometry& g = im.encoder->geometry();  // the grid just encoded (inference.grid_extent applied)
+  const NearFieldShare near_share{g, far ? options_.inference.far_field->margin : 0.0};
   std::vector<Box> candidates = model.head().decode(out, 0, g, options_.inference);
-  // With a far field the near model owns the boxes centred inside its grid shrunk by the margin, the far model every
-  // other one. Each model's candidates go through NMS and voting on their own (the far model's outside the near field
-  // only), so that inside the near field the boxes are the near model's as if it ran alone.
-  const double m = far ? options_.inference.far_field->margin : 0.0;
-  auto near_owns = [&](const Box& b) {
-    return b.x >= g.x_min + m && b.x < g.x_max - m && b.y >= g.y_min + m && b.y < g.y_max - m;
-  };
   std::vector<Box> far_candidates;
-  if (far) {
+  if (far) {  // the far model's candidates outside the near field only
     far_candidates = im.far_model->head().decode(far_out, 0, im.far_encoder->geometry(), im.far_inference);
-    far_candidates.erase(std::remove_if(far_candidates.begin(), far_candidates.end(), near_owns), far_candidates.end());
+    far_candidates.erase(std::remove_if(far_candidates.begin(), far_candidates.end(),
+                                        [&](const Box& b) { return near_share.owns(b); }),
+                         far_candidates.end());
   }
   timings_.decode_ms = msSince(t0);
 
   t0 = std::chrono::steady_clock::now();
   const InferenceOptions& o = options_.inference;
-  auto suppress = [&](const std::vector<Box>& c) {
-    const auto keep = rotatedNms(c, o.nms_iou, true, static_cast<std::size_t>(std::max(0, o.max_detections)));
-    if (o.nms_voting_iou > 0) return voteBoxes(c, keep, o.nms_voting_iou);
-    std::vector<Box> kept;
-    kept.reserve(keep.size());
-    for (std::size_t i : keep) kept.push_back(c[i]);
-    return kept;
-  };
   Detections det;
-  det.boxes = suppress(candidates);
+  det.boxes = suppress(candidates, o);
   std::vector<Box> far_boxes;
   if (far) {
-    det.boxes.erase(std::remove_if(det.boxes.begin(), det.boxes.end(), [&](const Box& b) { return !near_owns(b); }),
-                    det.boxes.end());
-    far_boxes = suppress(far_candidates);
-    // A far box overlapping a near one of its class across the boundary yields to it, as NMS would have it.
-    far_boxes.erase(std::remove_if(far_boxes.begin(), far_boxes.end(),
-                                   [&](const Box& f) {
-                                     return std::any_of(det.boxes.begin(), det.boxes.end(), [&](const Box& n) {
-                                       return n.label == f.label && bevIoU(n, f) > o.nms_iou;
-                                     });
-                                   }),
-                    far_boxes.end());
+    far_boxes = suppress(far_candidates, o);
+    mergeFields(near_share, o.nms_iou, &det.boxes, &far_boxes);
   }
   timings_.nms_ms = msSince(t0);
 
   t0 = std::chrono::steady_clock::now();
   // Each box refined and scored by its own model's options.
-  if (o.point_refine.enabled()) refineBoxesFromPoints(current, &det.boxes, o.point_refine);
-  headingFromVelocity(&det.boxes, o.heading_from_velocity);
-  if (!far_boxes.empty()) {
-    if (im.far_inference.point_refine.enabled()) refineBoxesFromPoints(current, &far_boxes, im.far_inference.point_refine);
-    headingFromVelocity(&far_boxes, im.far_inference.heading_from_velocity);
-  }
-  // Calibrated classes were let in below score_threshold (candidate_threshold): their final scores decide.
-  const float min_score = o.score_threshold;
-  // Nothing stands inside or against the vehicle's own body.
-  auto low = [&](const Box& b) {
-    return b.score < min_score || (ego && ego->touches(b, im.sensor_to_base, InferenceOptions::kEgoMargin));
-  };
-  det.boxes.erase(std::remove_if(det.boxes.begin(), det.boxes.end(), low), det.boxes.end());
-  far_boxes.erase(std::remove_if(far_boxes.begin(), far_boxes.end(), low), far_boxes.end());
+  refineBoxes(current, o, &det.boxes);
+  if (!far_boxes.empty()) refineBoxes(current, im.far_inference, &far_boxes);
+  dropLowOrOnEgo(o.score_threshold, ego ? &*ego : nullptr, im.sensor_to_base, &det.boxes);
+  dropLowOrOnEgo(o.score_threshold, ego ? &*ego : nullptr, im.sensor_to_base, &far_boxes);
   timings_.refine_ms = msSince(t0);
 
   // The features o_i belong to decoding (Ret3D §3.1): timed with it. Each box's from its own model's map; the boxes
   // then ordered by descending score, their feature rows with them.
   t0 = std::chrono::steady_clock::now();
   torch::Tensor f = nn::sampleFeatures(out.features[0], det.boxes, g, options_.model.featureStride());
-  if (far) {
-    const torch::Tensor ff =
-        nn::sampleFeatures(far_out.features[0], far_boxes, im.far_encoder->geometry(), im.far_model->config().featureStride());
-    f = torch::cat({f, ff}, 0);
-    det.boxes.insert(det.boxes.end(), far_boxes.begin(), far_boxes.end());
-    std::vector<std::int64_t> order(det.boxes.size());
-    std::iota(order.begin(), order.end(), 0);
-    std::stable_sort(order.begin(), order.end(),
-                     [&](std::int64_t a, std::int64_t b) { return det.boxes[a].score > det.boxes[b].score; });
-    std::vector<Box> sorted;
-    sorted.reserve(order.size());
-    for (std::int64_t i : order) sorted.push_back(det.boxes[i]);
-    det.boxes = std::move(sorted);
-    f = f.index_select(0, torch::tensor(order, torch::kLong)).contiguous();
-  }
+  if (far)
+    appendFarField(far_boxes,
+                   nn::sampleFeatures(far_out.features[0], far_boxes, im.far_encoder->geometry(),
+                                      im.far_model->config().featureStride()),
+                   &det.boxes, &f);
   det.feature_dim = static_cast<std::size_t>(f.size(1));
   det.features.assign(f.data_ptr<float>(), f.data_ptr<float>() + f.numel());
   timings_.decode_ms += msSince(t0);

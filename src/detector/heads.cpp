@@ -128,6 +128,68 @@ class AnchorHead : public DetectionHead {
       net.initClassificationBias(kv.first, 0, 1, D_, 0.01, static_cast<int>(kv.second.size()) * D_);
   }
 
+  // One stride's training targets: objectness and its weights (N A h w), and per positive its (n, a, v, u), class,
+  // box code, velocity validity and object.
+  struct StrideTargets {
+    torch::Tensor obj_t, weight;
+    std::vector<int64_t> idx_n, idx_a, idx_v, idx_u, cls;
+    std::vector<float> codes, vvalid;
+    std::vector<const Box*> pos_box;
+  };
+
+  // The best anchor of the box's class over all scales: its stride and index (-1: none of the class).
+  std::pair<int, int> bestAnchor(const Box& b) const {
+    double best_iou = -1;
+    int best_stride = 0, best_a = -1;
+    for (const auto& [s2, an2] : per_stride_)
+      for (int a = 0; a < static_cast<int>(an2.size()); ++a) {
+        if (an2[a].label != b.label) continue;
+        const double iou = anchorShapeIoU(an2[a], b.length, b.width, b.height, b.z);
+        if (iou > best_iou) best_iou = iou, best_stride = s2, best_a = a;
+      }
+    return {best_stride, best_a};
+  }
+
+  // Positives of one stride: a box's best anchor if this stride holds it, plus this stride's anchors of the class
+  // that fit nearly as well (IoU >= 0.5), in the box's cell and up to neighbour_cells nearest neighbours.
+  StrideTargets assignTargets(const std::vector<GroundTruth>& gt, const BevGeometry& g, int stride,
+                              const std::vector<Anchor>& anchors, int N, int h, int w) const {
+    const int A = static_cast<int>(anchors.size());
+    StrideTargets T;
+    T.obj_t = torch::zeros({N, A, h, w});
+    T.weight = torch::ones({N, A, h, w});
+    for (int n = 0; n < N; ++n) {
+      T.weight[n].mul_(supervisionMask(gt[n], g, stride, h, w).unsqueeze(0));
+      for (std::size_t bi = 0; bi < gt[n].boxes.size(); ++bi) {
+        const Box& b = gt[n].boxes[bi];
+        const int c = classIndex(config_.classes, b.label);
+        if (c < 0) continue;
+        const auto [best_stride, best_a] = bestAnchor(b);
+        const Eigen::Vector2d f = g.metricToFeature(b.x, b.y, stride);
+        const int u0 = static_cast<int>(std::floor(f.x())), v0 = static_cast<int>(std::floor(f.y()));
+        std::vector<std::pair<int, int>> cells = {{u0, v0}};
+        if (config_.anchor.neighbour_cells > 0) cells.push_back({f.x() - u0 < 0.5 ? u0 - 1 : u0 + 1, v0});
+        if (config_.anchor.neighbour_cells > 1) cells.push_back({u0, f.y() - v0 < 0.5 ? v0 - 1 : v0 + 1});
+        for (int a = 0; a < A; ++a) {
+          if (anchors[a].label != b.label) continue;
+          const bool best = stride == best_stride && a == best_a;
+          if (!best && anchorShapeIoU(anchors[a], b.length, b.width, b.height, b.z) < 0.5) continue;
+          for (const auto& [u, v] : cells) {
+            if (u < 0 || v < 0 || u >= w || v >= h) continue;
+            T.obj_t[n][a][v][u] = 1.0f;
+            T.weight[n][a][v][u] = 1.0f;
+            T.idx_n.push_back(n), T.idx_a.push_back(a), T.idx_v.push_back(v), T.idx_u.push_back(u), T.cls.push_back(c);
+            const BoxCode code = encodeAnchorBox(b, anchors[a], u, v, stride, g, config_.sweep_interval);
+            T.codes.insert(T.codes.end(), code.begin(), code.end());
+            T.vvalid.push_back(velocityValid(gt[n], bi) ? 1.0f : 0.0f);
+            T.pos_box.push_back(&b);
+          }
+        }
+      }
+    }
+    return T;
+  }
+
   HeadLoss loss(const NetworkOutput& out, const std::vector<GroundTruth>& gt, const BevGeometry& g,
                 const TrainOptions& t) const override {
     HeadLoss L;
@@ -140,67 +202,26 @@ class AnchorHead : public DetectionHead {
       const int N = static_cast<int>(raw.size(0)), h = static_cast<int>(raw.size(2)), w = static_cast<int>(raw.size(3));
       const int A = static_cast<int>(anchors.size());
       auto r = raw.narrow(1, 0, A * D_).reshape({N, A, D_, h, w}).permute({0, 1, 3, 4, 2});  // N A h w D
-      auto obj_t = torch::zeros({N, A, h, w});
-      auto weight = torch::ones({N, A, h, w});
-      std::vector<int64_t> idx_n, idx_a, idx_v, idx_u, cls;
-      std::vector<float> codes, vvalid;
-      std::vector<const Box*> pos_box;  // the object of each positive
-      for (int n = 0; n < N; ++n) {
-        weight[n].mul_(supervisionMask(gt[n], g, stride, h, w).unsqueeze(0));
-        for (std::size_t bi = 0; bi < gt[n].boxes.size(); ++bi) {
-          const Box& b = gt[n].boxes[bi];
-          const int c = classIndex(config_.classes, b.label);
-          if (c < 0) continue;
-          // The best anchor of the box's class over all scales; this stride takes it if it holds that anchor,
-          // plus its own anchors of the class that fit nearly as well (IoU >= 0.5).
-          double best_iou = -1;
-          int best_stride = 0, best_a = -1;
-          for (const auto& [s2, an2] : per_stride_)
-            for (int a = 0; a < static_cast<int>(an2.size()); ++a) {
-              if (an2[a].label != b.label) continue;
-              const double iou = anchorShapeIoU(an2[a], b.length, b.width, b.height, b.z);
-              if (iou > best_iou) best_iou = iou, best_stride = s2, best_a = a;
-            }
-          const Eigen::Vector2d f = g.metricToFeature(b.x, b.y, stride);
-          const int u0 = static_cast<int>(std::floor(f.x())), v0 = static_cast<int>(std::floor(f.y()));
-          std::vector<std::pair<int, int>> cells = {{u0, v0}};
-          if (config_.anchor.neighbour_cells > 0) cells.push_back({f.x() - u0 < 0.5 ? u0 - 1 : u0 + 1, v0});
-          if (config_.anchor.neighbour_cells > 1) cells.push_back({u0, f.y() - v0 < 0.5 ? v0 - 1 : v0 + 1});
-          for (int a = 0; a < A; ++a) {
-            if (anchors[a].label != b.label) continue;
-            const bool best = stride == best_stride && a == best_a;
-            if (!best && anchorShapeIoU(anchors[a], b.length, b.width, b.height, b.z) < 0.5) continue;
-            for (const auto& [u, v] : cells) {
-              if (u < 0 || v < 0 || u >= w || v >= h) continue;
-              obj_t[n][a][v][u] = 1.0f;
-              weight[n][a][v][u] = 1.0f;
-              idx_n.push_back(n), idx_a.push_back(a), idx_v.push_back(v), idx_u.push_back(u), cls.push_back(c);
-              const BoxCode code = encodeAnchorBox(b, anchors[a], u, v, stride, g, config_.sweep_interval);
-              codes.insert(codes.end(), code.begin(), code.end());
-              vvalid.push_back(velocityValid(gt[n], bi) ? 1.0f : 0.0f);
-              pos_box.push_back(&b);
-            }
-          }
-        }
-      }
-      obj_sum = obj_sum + sigmoidFocal(r.select(4, 0), obj_t, weight);
-      const int64_t P = static_cast<int64_t>(idx_n.size());
+      StrideTargets T = assignTargets(gt, g, stride, anchors, N, h, w);
+      obj_sum = obj_sum + sigmoidFocal(r.select(4, 0), T.obj_t, T.weight);
+      const int64_t P = static_cast<int64_t>(T.idx_n.size());
       positives += P;
       if (P == 0) continue;
       auto opt = torch::TensorOptions().dtype(torch::kLong);
       // The positives' (n, a, v, u), indexing the box channels and, with quality, the IoU channels.
-      const std::vector<torch::Tensor> at = {torch::tensor(idx_n, opt), torch::tensor(idx_a, opt),
-                                             torch::tensor(idx_v, opt), torch::tensor(idx_u, opt)};
+      const std::vector<torch::Tensor> at = {torch::tensor(T.idx_n, opt), torch::tensor(T.idx_a, opt),
+                                             torch::tensor(T.idx_v, opt), torch::tensor(T.idx_u, opt)};
       auto sel = r.index({at[0], at[1], at[2], at[3]});  // P x D
-      cls_sum = cls_sum + F::cross_entropy(sel.index({Slice(), Slice(1, 1 + C_)}), torch::tensor(cls, opt),
+      cls_sum = cls_sum + F::cross_entropy(sel.index({Slice(), Slice(1, 1 + C_)}), torch::tensor(T.cls, opt),
                                            F::CrossEntropyFuncOptions().reduction(torch::kSum));
       auto reg = sel.index({Slice(), Slice(1 + C_, D_)});
       // The centre offset is 2 sigmoid - 0.5 (YOLOv5), the rest raw.
       reg = torch::cat({2 * torch::sigmoid(reg.index({Slice(), Slice(0, 2)})) - 0.5, reg.index({Slice(), Slice(2, kBoxCodeSize)})}, 1);
-      if (quality_) iou_sum = iou_sum + qualityLoss(raw, A, reg, at, idx_a, idx_v, idx_u, pos_box, anchors, stride, g);
+      if (quality_)
+        iou_sum = iou_sum + qualityLoss(raw, A, reg, at, T.idx_a, T.idx_v, T.idx_u, T.pos_box, anchors, stride, g);
       preds.push_back(reg);
-      targets.push_back(torch::from_blob(codes.data(), {P, kBoxCodeSize}).clone());
-      valids.push_back(torch::tensor(vvalid));
+      targets.push_back(torch::from_blob(T.codes.data(), {P, kBoxCodeSize}).clone());
+      valids.push_back(torch::tensor(T.vvalid));
     }
     const double norm = std::max<int64_t>(1, positives);
     auto obj = obj_sum / norm, cl = cls_sum / norm;

@@ -15,19 +15,21 @@ constexpr double kEps = 2.220446049250313e-16;  // numpy's float eps, as TrackEv
 double alphaAt(int a) { return 0.05 * (a + 1); }
 }  // namespace
 
-void accumulateHota(const MotSequence& seq, HotaSums& sums) {
-  if (seq.num_pred_dets == 0) {
-    for (int a = 0; a < kHotaAlphas; ++a) sums.fn[a] += seq.num_gt_dets;
-    return;
-  }
-  if (seq.num_gt_dets == 0) {
-    for (int a = 0; a < kHotaAlphas; ++a) sums.fp[a] += seq.num_pred_dets;
-    return;
-  }
+namespace {
+
+// Pass 1: the global alignment between ground-truth and predicted ids, from similarity normalised per timestep (a
+// soft Jaccard count), with each id's number of detections.
+struct IdAlignment {
+  std::vector<double> alignment;  // gt id x pred id
+  std::vector<double> gt_count, pred_count;
+};
+
+IdAlignment alignIds(const MotSequence& seq) {
   const int ng = seq.num_gt_ids, np = seq.num_pred_ids;
-  // Pass 1: global alignment between ids, from similarity normalised per timestep (a soft Jaccard count).
   std::vector<double> potential(static_cast<std::size_t>(ng) * np, 0.0);
-  std::vector<double> gt_count(ng, 0.0), pred_count(np, 0.0);
+  IdAlignment al;
+  al.gt_count.assign(ng, 0.0);
+  al.pred_count.assign(np, 0.0);
   for (const MotTimestep& t : seq.steps) {
     const std::size_t nr = t.gt_ids.size(), nc = t.pred_ids.size();
     std::vector<double> row_sum(nr, 0.0), col_sum(nc, 0.0);
@@ -43,20 +45,31 @@ void accumulateHota(const MotSequence& seq, HotaSums& sums) {
         if (denom > kEps) potential[static_cast<std::size_t>(t.gt_ids[g]) * np + t.pred_ids[p]] += t.at(g, p) / denom;
       }
     }
-    for (int id : t.gt_ids) gt_count[id] += 1;
-    for (int id : t.pred_ids) pred_count[id] += 1;
+    for (int id : t.gt_ids) al.gt_count[id] += 1;
+    for (int id : t.pred_ids) al.pred_count[id] += 1;
   }
-  std::vector<double> alignment(potential.size());
+  al.alignment.resize(potential.size());
   for (int g = 0; g < ng; ++g) {
     for (int p = 0; p < np; ++p) {
       const std::size_t k = static_cast<std::size_t>(g) * np + p;
-      alignment[k] = potential[k] / (gt_count[g] + pred_count[p] - potential[k]);
+      al.alignment[k] = potential[k] / (al.gt_count[g] + al.pred_count[p] - potential[k]);
     }
   }
-  // Pass 2: per timestep, match by alignment x similarity, then count at each alpha.
+  return al;
+}
+
+// Pass 2's counts at each alpha: matched id pairs (gt id x pred id), true positives, summed localisation.
+struct AlphaMatches {
   std::array<std::vector<double>, kHotaAlphas> matches;
-  for (auto& m : matches) m.assign(potential.size(), 0.0);
   std::array<double, kHotaAlphas> tp{}, loca{};
+};
+
+// Pass 2: per timestep, match by alignment x similarity, then count at each alpha (false positives and negatives
+// straight into sums).
+AlphaMatches matchTimesteps(const MotSequence& seq, const IdAlignment& al, HotaSums& sums) {
+  const int np = seq.num_pred_ids;
+  AlphaMatches am;
+  for (auto& m : am.matches) m.assign(al.alignment.size(), 0.0);
   for (const MotTimestep& t : seq.steps) {
     const std::size_t nr = t.gt_ids.size(), nc = t.pred_ids.size();
     if (nr == 0 || nc == 0) {
@@ -69,7 +82,7 @@ void accumulateHota(const MotSequence& seq, HotaSums& sums) {
     std::vector<double> score(nr * nc);
     for (std::size_t g = 0; g < nr; ++g) {
       for (std::size_t p = 0; p < nc; ++p) {
-        score[g * nc + p] = alignment[static_cast<std::size_t>(t.gt_ids[g]) * np + t.pred_ids[p]] * t.at(g, p);
+        score[g * nc + p] = al.alignment[static_cast<std::size_t>(t.gt_ids[g]) * np + t.pred_ids[p]] * t.at(g, p);
       }
     }
     const std::vector<int> assign = maximiseAssignment(score, static_cast<int>(nr), static_cast<int>(nc));
@@ -80,31 +93,48 @@ void accumulateHota(const MotSequence& seq, HotaSums& sums) {
         const double s = t.at(g, assign[g]);
         if (s < alphaAt(a) - kEps) continue;
         ++n_match;
-        loca[a] += s;
-        matches[a][static_cast<std::size_t>(t.gt_ids[g]) * np + t.pred_ids[assign[g]]] += 1;
+        am.loca[a] += s;
+        am.matches[a][static_cast<std::size_t>(t.gt_ids[g]) * np + t.pred_ids[assign[g]]] += 1;
       }
-      tp[a] += n_match;
+      am.tp[a] += n_match;
       sums.fn[a] += nr - n_match;
       sums.fp[a] += nc - n_match;
     }
   }
+  return am;
+}
+
+}  // namespace
+
+void accumulateHota(const MotSequence& seq, HotaSums& sums) {
+  if (seq.num_pred_dets == 0) {
+    for (int a = 0; a < kHotaAlphas; ++a) sums.fn[a] += seq.num_gt_dets;
+    return;
+  }
+  if (seq.num_gt_dets == 0) {
+    for (int a = 0; a < kHotaAlphas; ++a) sums.fp[a] += seq.num_pred_dets;
+    return;
+  }
+  const int ng = seq.num_gt_ids, np = seq.num_pred_ids;
+  const IdAlignment al = alignIds(seq);
+  const AlphaMatches am = matchTimesteps(seq, al, sums);
   for (int a = 0; a < kHotaAlphas; ++a) {
     double assa = 0, assre = 0, asspr = 0;
     for (int g = 0; g < ng; ++g) {
       for (int p = 0; p < np; ++p) {
-        const double m = matches[a][static_cast<std::size_t>(g) * np + p];
+        const double m = am.matches[a][static_cast<std::size_t>(g) * np + p];
         if (m == 0) continue;
-        assa += m * m / std::max(1.0, gt_count[g] + pred_count[p] - m);
-        assre += m * m / std::max(1.0, gt_count[g]);
-        asspr += m * m / std::max(1.0, pred_count[p]);
+        assa += m * m / std::max(1.0, al.gt_count[g] + al.pred_count[p] - m);
+        assre += m * m / std::max(1.0, al.gt_count[g]);
+        asspr += m * m / std::max(1.0, al.pred_count[p]);
       }
     }
     // The sequence's AssA is the sum over TP / TP; weighted by TP for the combination that is the sum itself.
-    sums.tp[a] += tp[a];
+    sums.tp[a] += am.tp[a];
     sums.assa_w[a] += assa;
     sums.assre_w[a] += assre;
     sums.asspr_w[a] += asspr;
-    sums.loca_w[a] += loca[a];
+    sums.loca_w[a] += am.loca[a];
   }
 }
 

@@ -112,8 +112,10 @@ bool runGnuplot(const std::string& script_path) {
   return WIFEXITED(status) && WEXITSTATUS(status) == 0;
 }
 
-std::map<std::string, double> metricsMap(const EvalReport& r) {
-  std::map<std::string, double> m;
+namespace {
+
+// Frames, boxes, the min_points counts, and the KITTI per-class detection and ground-truth counts.
+void addCounts(std::map<std::string, double>& m, const EvalReport& r) {
   m["count.frames"] = static_cast<double>(r.num_frames);
   m["count.gt"] = static_cast<double>(r.num_gt);
   m["count.pred"] = static_cast<double>(r.num_pred);
@@ -124,74 +126,88 @@ std::map<std::string, double> metricsMap(const EvalReport& r) {
       m[std::string("min_points.") + className(cls) + ".ignored"] = static_cast<double>(c.ignored);
     }
   }
-  if (r.kitti) {
-    addKitti(m, "kitti", *r.kitti);
-    for (const auto& c : r.kitti->classes) {
+}
+
+// KITTI AP, its counts and the false boxes per frame.
+void addKittiMetrics(std::map<std::string, double>& m, const KittiResult& k) {
+  addKitti(m, "kitti", k);
+  for (const auto& c : k.classes) {
+    const std::string cls = className(c.cls);
+    m["count.kitti." + cls + ".det"] = c.num_det;
+    for (int d = 0; d < kKittiNumDifficulties; ++d) {
+      m["count.kitti." + cls + ".gt." + difficultyKey(static_cast<KittiDifficulty>(d))] = c.curves[2][d].num_gt;
+    }
+  }
+  const KittiFalseBoxes& fb = k.false_boxes;
+  const double nf = static_cast<double>(std::max<std::size_t>(1, k.num_frames));
+  m["kitti.false_boxes_per_frame"] = fb.total() / nf;
+  m["kitti.false_boxes_per_frame.score50"] = fb.totalScore50() / nf;
+  for (const auto& c : k.classes) {
+    const std::size_t i = static_cast<std::size_t>(c.cls) - 1;
+    m[std::string("kitti.false_boxes_per_frame.") + className(c.cls)] = fb.per_class[i] / nf;
+  }
+  m["kitti.exact_recall"] = k.exact_recall ? 1 : 0;
+}
+
+// Waymo AP / APH per class and level, per range bin, and their means.
+void addWaymo(std::map<std::string, double>& m, const WaymoResult& w, const WaymoOptions& options) {
+  for (int l = 0; l < kWaymoNumLevels; ++l) {
+    const std::string level = levelKey(static_cast<WaymoLevel>(l));
+    for (const auto& c : w.classes) {
       const std::string cls = className(c.cls);
-      m["count.kitti." + cls + ".det"] = c.num_det;
-      for (int d = 0; d < kKittiNumDifficulties; ++d) {
-        m["count.kitti." + cls + ".gt." + difficultyKey(static_cast<KittiDifficulty>(d))] = c.curves[2][d].num_gt;
+      m["waymo." + cls + "." + level + ".AP"] = c.levels[l].ap;
+      m["waymo." + cls + "." + level + ".APH"] = c.levels[l].aph;
+      m["count.waymo." + cls + "." + level + ".gt"] = c.levels[l].num_gt;
+      for (std::size_t k = 0; k < c.ranges.size() && k < options.ranges.size(); ++k) {
+        const std::string base = "waymo_range." + cls + "." + options.ranges[k].name + "." + level;
+        m[base + ".AP"] = c.ranges[k][l].ap;
+        m[base + ".APH"] = c.ranges[k][l].aph;
       }
     }
+    m["waymo.mean." + level + ".AP"] = w.mean_ap[l];
+    m["waymo.mean." + level + ".APH"] = w.mean_aph[l];
   }
-  if (r.kitti) {
-    const KittiFalseBoxes& fb = r.kitti->false_boxes;
-    const double nf = static_cast<double>(std::max<std::size_t>(1, r.kitti->num_frames));
-    m["kitti.false_boxes_per_frame"] = fb.total() / nf;
-    m["kitti.false_boxes_per_frame.score50"] = fb.totalScore50() / nf;
-    for (const auto& c : r.kitti->classes) {
-      const std::size_t k = static_cast<std::size_t>(c.cls) - 1;
-      m[std::string("kitti.false_boxes_per_frame.") + className(c.cls)] = fb.per_class[k] / nf;
-    }
-    m["kitti.exact_recall"] = r.kitti->exact_recall ? 1 : 0;
+}
+
+// CLEAR MOT and HOTA per class (headline figures under mot., the rest under mot_detail.).
+void addMot(std::map<std::string, double>& m, const MotResult& mot, const MotOptions& options) {
+  m["mot_detail.max_range"] = options.max_range;
+  for (const auto& c : mot.classes) {
+    const std::string p = "mot." + std::string(className(c.cls)) + ".";
+    const double tracks = std::max(1, c.clear.num_gt_tracks);
+    m[p + "MOTA"] = c.clear.mota;
+    m[p + "MOTP"] = c.clear.motp;
+    m[p + "IDSW"] = c.clear.idsw;
+    m[p + "FRAG"] = c.clear.frag;
+    m[p + "MT"] = 100.0 * c.clear.mt / tracks;
+    m[p + "ML"] = 100.0 * c.clear.ml / tracks;
+    m[p + "HOTA"] = c.hota.hota;
+    m[p + "DetA"] = c.hota.deta;
+    m[p + "AssA"] = c.hota.assa;
+    const std::string q = "mot_detail." + std::string(className(c.cls)) + ".";
+    m[q + "TP"] = c.clear.tp;
+    m[q + "FP"] = c.clear.fp;
+    m[q + "FN"] = c.clear.fn;
+    m[q + "PT"] = 100.0 * c.clear.pt / tracks;
+    m[q + "GT_tracks"] = c.clear.num_gt_tracks;
+    m[q + "pred_tracks"] = c.num_pred_tracks;
+    m[q + "DetRe"] = c.hota.detre;
+    m[q + "DetPr"] = c.hota.detpr;
+    m[q + "AssRe"] = c.hota.assre;
+    m[q + "AssPr"] = c.hota.asspr;
+    m[q + "LocA"] = c.hota.loca;
   }
+}
+
+}  // namespace
+
+std::map<std::string, double> metricsMap(const EvalReport& r) {
+  std::map<std::string, double> m;
+  addCounts(m, r);
+  if (r.kitti) addKittiMetrics(m, *r.kitti);
   if (r.kitti_loose) addKitti(m, "kitti_loose", *r.kitti_loose);
-  if (r.waymo) {
-    for (int l = 0; l < kWaymoNumLevels; ++l) {
-      const std::string level = levelKey(static_cast<WaymoLevel>(l));
-      for (const auto& c : r.waymo->classes) {
-        const std::string cls = className(c.cls);
-        m["waymo." + cls + "." + level + ".AP"] = c.levels[l].ap;
-        m["waymo." + cls + "." + level + ".APH"] = c.levels[l].aph;
-        m["count.waymo." + cls + "." + level + ".gt"] = c.levels[l].num_gt;
-        for (std::size_t k = 0; k < c.ranges.size() && k < r.waymo_options.ranges.size(); ++k) {
-          const std::string base = "waymo_range." + cls + "." + r.waymo_options.ranges[k].name + "." + level;
-          m[base + ".AP"] = c.ranges[k][l].ap;
-          m[base + ".APH"] = c.ranges[k][l].aph;
-        }
-      }
-      m["waymo.mean." + level + ".AP"] = r.waymo->mean_ap[l];
-      m["waymo.mean." + level + ".APH"] = r.waymo->mean_aph[l];
-    }
-  }
-  if (r.mot) {
-    m["mot_detail.max_range"] = r.mot_options.max_range;
-    for (const auto& c : r.mot->classes) {
-      const std::string p = "mot." + std::string(className(c.cls)) + ".";
-      const double tracks = std::max(1, c.clear.num_gt_tracks);
-      m[p + "MOTA"] = c.clear.mota;
-      m[p + "MOTP"] = c.clear.motp;
-      m[p + "IDSW"] = c.clear.idsw;
-      m[p + "FRAG"] = c.clear.frag;
-      m[p + "MT"] = 100.0 * c.clear.mt / tracks;
-      m[p + "ML"] = 100.0 * c.clear.ml / tracks;
-      m[p + "HOTA"] = c.hota.hota;
-      m[p + "DetA"] = c.hota.deta;
-      m[p + "AssA"] = c.hota.assa;
-      const std::string q = "mot_detail." + std::string(className(c.cls)) + ".";
-      m[q + "TP"] = c.clear.tp;
-      m[q + "FP"] = c.clear.fp;
-      m[q + "FN"] = c.clear.fn;
-      m[q + "PT"] = 100.0 * c.clear.pt / tracks;
-      m[q + "GT_tracks"] = c.clear.num_gt_tracks;
-      m[q + "pred_tracks"] = c.num_pred_tracks;
-      m[q + "DetRe"] = c.hota.detre;
-      m[q + "DetPr"] = c.hota.detpr;
-      m[q + "AssRe"] = c.hota.assre;
-      m[q + "AssPr"] = c.hota.asspr;
-      m[q + "LocA"] = c.hota.loca;
-    }
-  }
+  if (r.waymo) addWaymo(m, *r.waymo, r.waymo_options);
+  if (r.mot) addMot(m, *r.mot, r.mot_options);
   if (r.id_stability) {
     auto add = [&m](const std::string& name, const IdStabilityCounts& c) {
       m["mot." + name + ".IdStability"] = c.stability();

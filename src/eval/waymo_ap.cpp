@@ -173,6 +173,79 @@ WaymoCurve curveFrom(std::vector<Step> steps, int num_gt) {
   return c;
 }
 
+// One frame's boxes of class `cls` (predictions in descending score) and their IoUs, computed once and shared by
+// every level and range; a ground-truth box without returns is not ground truth when point counts are used (counted
+// in *dropped).
+ClassFrame classFrame(const EvalFrame& f, ObjectClass cls, bool use_point_counts, std::size_t* dropped) {
+  ClassFrame cf;
+  for (std::size_t g = 0; g < f.gt_boxes.size(); ++g) {
+    const Box& b = f.gt_boxes[g];
+    if (b.label != cls) continue;
+    const bool ignore = g < f.gt_ignore.size() && f.gt_ignore[g];
+    if (use_point_counts && b.num_points == 0 && !ignore) {
+      ++*dropped;
+      continue;
+    }
+    cf.gt.push_back(&b);
+    cf.gt_ignore.push_back(ignore);
+  }
+  for (const Box& b : f.pred_boxes) {
+    if (b.label == cls) cf.pred.push_back(&b);
+  }
+  std::stable_sort(cf.pred.begin(), cf.pred.end(), [](const Box* a, const Box* b) { return a->score > b->score; });
+  cf.iou.resize(cf.pred.size() * cf.gt.size());
+  for (std::size_t p = 0; p < cf.pred.size(); ++p) {
+    for (std::size_t g = 0; g < cf.gt.size(); ++g) cf.iou[p * cf.gt.size() + g] = iou3d(*cf.pred[p], *cf.gt[g]);
+  }
+  return cf;
+}
+
+// The precision / recall curve of one configuration: a difficulty level (0: LEVEL_1, without the boxes of at most
+// level2_max_points returns) over all ranges (range < 0) or over one range bin, for both ground truth and predictions.
+WaymoCurve configurationCurve(const std::vector<ClassFrame>& cfs, const WaymoOptions& options, int level, int range,
+                              double iou_threshold) {
+  std::vector<Step> dets;
+  int num_gt = 0;
+  std::vector<char> valid, pred_used;
+  for (const ClassFrame& cf : cfs) {
+    valid.assign(cf.gt.size(), 1);
+    pred_used.assign(cf.pred.size(), 1);
+    for (std::size_t g = 0; g < cf.gt.size(); ++g) {
+      const bool level2 =
+          options.use_point_counts && static_cast<int>(cf.gt[g]->num_points) <= options.level2_max_points;
+      const bool out_of_range =
+          range >= 0 && (horizontalRange(*cf.gt[g]) < options.ranges[range].min ||
+                         horizontalRange(*cf.gt[g]) >= options.ranges[range].max);
+      valid[g] = !cf.gt_ignore[g] && !(level == 0 && level2) && !out_of_range;
+    }
+    if (range >= 0) {
+      for (std::size_t p = 0; p < cf.pred.size(); ++p) {
+        const double r = horizontalRange(*cf.pred[p]);
+        pred_used[p] = r >= options.ranges[range].min && r < options.ranges[range].max;
+      }
+    }
+    num_gt += matchFrame(cf, valid, pred_used, iou_threshold, dets);
+  }
+  return curveFrom(std::move(dets), num_gt);
+}
+
+// mAP and mAPH per level: the mean over the classes that have ground truth at that level.
+void averageOverClasses(WaymoResult& result) {
+  for (int l = 0; l < kWaymoNumLevels; ++l) {
+    int n = 0;
+    for (const auto& cr : result.classes) {
+      if (cr.levels[l].num_gt == 0) continue;
+      result.mean_ap[l] += cr.levels[l].ap;
+      result.mean_aph[l] += cr.levels[l].aph;
+      ++n;
+    }
+    if (n > 0) {
+      result.mean_ap[l] /= n;
+      result.mean_aph[l] /= n;
+    }
+  }
+}
+
 }  // namespace
 
 WaymoResult evaluateWaymo(const std::vector<EvalFrame>& frames, const WaymoOptions& options) {
@@ -189,31 +262,10 @@ WaymoResult evaluateWaymo(const std::vector<EvalFrame>& frames, const WaymoOptio
     if (ci < 0 || ci > 2) throw std::invalid_argument("evaluateWaymo: only Car, Pedestrian and Cyclist are evaluated");
     cr.iou_threshold = options.iou_threshold[ci];
 
-    // Per frame: the class's boxes and their IoUs (computed once, shared by every level and range).
     std::vector<ClassFrame> cfs(frames.size());
     std::vector<std::size_t> dropped(frames.size(), 0);
     detail::parallelFor(frames.size(), options.threads, [&](std::size_t i) {
-      const EvalFrame& f = frames[i];
-      ClassFrame& cf = cfs[i];
-      for (std::size_t g = 0; g < f.gt_boxes.size(); ++g) {
-        const Box& b = f.gt_boxes[g];
-        if (b.label != cr.cls) continue;
-        const bool ignore = g < f.gt_ignore.size() && f.gt_ignore[g];
-        if (options.use_point_counts && b.num_points == 0 && !ignore) {  // not in the ground truth
-          ++dropped[i];
-          continue;
-        }
-        cf.gt.push_back(&b);
-        cf.gt_ignore.push_back(ignore);
-      }
-      for (const Box& b : f.pred_boxes) {
-        if (b.label == cr.cls) cf.pred.push_back(&b);
-      }
-      std::stable_sort(cf.pred.begin(), cf.pred.end(), [](const Box* a, const Box* b) { return a->score > b->score; });
-      cf.iou.resize(cf.pred.size() * cf.gt.size());
-      for (std::size_t p = 0; p < cf.pred.size(); ++p) {
-        for (std::size_t g = 0; g < cf.gt.size(); ++g) cf.iou[p * cf.gt.size() + g] = iou3d(*cf.pred[p], *cf.gt[g]);
-      }
+      cfs[i] = classFrame(frames[i], cr.cls, options.use_point_counts, &dropped[i]);
     });
     for (std::size_t n : dropped) result.dropped_empty_gt += n;
     progress.tick();
@@ -224,29 +276,7 @@ WaymoResult evaluateWaymo(const std::vector<EvalFrame>& frames, const WaymoOptio
     detail::parallelFor(n_configs, options.threads, [&](std::size_t k) {
       const int level = static_cast<int>(k % kWaymoNumLevels);
       const int range = static_cast<int>(k / kWaymoNumLevels) - 1;  // -1: all ranges
-      std::vector<Step> dets;
-      int num_gt = 0;
-      std::vector<char> valid, pred_used;
-      for (const ClassFrame& cf : cfs) {
-        valid.assign(cf.gt.size(), 1);
-        pred_used.assign(cf.pred.size(), 1);
-        for (std::size_t g = 0; g < cf.gt.size(); ++g) {
-          const bool level2 =
-              options.use_point_counts && static_cast<int>(cf.gt[g]->num_points) <= options.level2_max_points;
-          const bool out_of_range =
-              range >= 0 && (horizontalRange(*cf.gt[g]) < options.ranges[range].min ||
-                             horizontalRange(*cf.gt[g]) >= options.ranges[range].max);
-          valid[g] = !cf.gt_ignore[g] && !(level == 0 && level2) && !out_of_range;
-        }
-        if (range >= 0) {
-          for (std::size_t p = 0; p < cf.pred.size(); ++p) {
-            const double r = horizontalRange(*cf.pred[p]);
-            pred_used[p] = r >= options.ranges[range].min && r < options.ranges[range].max;
-          }
-        }
-        num_gt += matchFrame(cf, valid, pred_used, cr.iou_threshold, dets);
-      }
-      WaymoCurve curve = curveFrom(std::move(dets), num_gt);
+      WaymoCurve curve = configurationCurve(cfs, options, level, range, cr.iou_threshold);
       if (range < 0) {
         cr.levels[level] = std::move(curve);
       } else {
@@ -255,19 +285,7 @@ WaymoResult evaluateWaymo(const std::vector<EvalFrame>& frames, const WaymoOptio
       progress.tick();
     });
   }
-  for (int l = 0; l < kWaymoNumLevels; ++l) {
-    int n = 0;
-    for (const auto& cr : result.classes) {
-      if (cr.levels[l].num_gt == 0) continue;
-      result.mean_ap[l] += cr.levels[l].ap;
-      result.mean_aph[l] += cr.levels[l].aph;
-      ++n;
-    }
-    if (n > 0) {
-      result.mean_ap[l] /= n;
-      result.mean_aph[l] /= n;
-    }
-  }
+  averageOverClasses(result);
   return result;
 }
 

@@ -129,21 +129,10 @@ std::optional<FieldReader> findField(const sensor_msgs::PointCloud2& msg, std::i
   return std::nullopt;
 }
 
-}  // namespace
-
-PointCloud toCloud(const sensor_msgs::PointCloud2& msg, const CloudConversionOptions& options,
-                   CloudConversionReport* report) {
-  CloudConversionReport local_report;
-  CloudConversionReport& rep = report ? *report : local_report;
-  rep = CloudConversionReport{};
-
-  PointCloud cloud;
+// The message's sizes against each other and its data: a clear error naming the mismatch.
+void checkCloudLayout(const sensor_msgs::PointCloud2& msg, const CloudConversionOptions& options) {
   const std::size_t width = msg.width, height = msg.height;
   const std::size_t n = width * height;
-  rep.input_points = n;
-  // An empty message (even a default-constructed one without fields) is a valid empty scan.
-  if (n == 0) return cloud;
-
   if (msg.point_step == 0)
     throw std::invalid_argument("PointCloud2 has point_step 0 with " + std::to_string(n) + " points");
   if (msg.row_step < width * msg.point_step) {
@@ -162,7 +151,16 @@ PointCloud toCloud(const sensor_msgs::PointCloud2& msg, const CloudConversionOpt
   if (options.intensity_scaling == IntensityScaling::FixedScale && !(options.intensity_scale > 0.0)) {
     throw std::invalid_argument("CloudConversionOptions::intensity_scale must be > 0 for FixedScale");
   }
+}
 
+// The fields read: x, y, z (required), intensity, ring and time when present (and asked for).
+struct CloudFields {
+  FieldReader x, y, z;
+  std::optional<FieldReader> intensity, ring, time;
+};
+
+CloudFields findCloudFields(const sensor_msgs::PointCloud2& msg, const CloudConversionOptions& options,
+                            CloudConversionReport& rep) {
   const auto fx = findField(msg, {"x"});
   const auto fy = findField(msg, {"y"});
   const auto fz = findField(msg, {"z"});
@@ -175,31 +173,34 @@ PointCloud toCloud(const sensor_msgs::PointCloud2& msg, const CloudConversionOpt
                                                   : "z") +
                                 "' (fields: " + (present.empty() ? "none" : present) + ")");
   }
-  const auto fi = findField(msg, {"intensity", "i", "reflectivity"});
-  const auto fring = options.keep_ring ? findField(msg, {"ring"}) : std::nullopt;
-  const auto ftime = options.keep_time ? findField(msg, {"time", "t", "timestamp"}) : std::nullopt;
-  if (fi) {
-    rep.intensity_field = fi->name;
+  CloudFields f{*fx, *fy, *fz, findField(msg, {"intensity", "i", "reflectivity"}),
+                options.keep_ring ? findField(msg, {"ring"}) : std::nullopt,
+                options.keep_time ? findField(msg, {"time", "t", "timestamp"}) : std::nullopt};
+  if (f.intensity) {
+    rep.intensity_field = f.intensity->name;
   } else {
     rep.warnings.push_back("no intensity field (intensity, i or reflectivity): intensities set to 0");
   }
-  if (fring) rep.has_ring = true;
-  if (ftime) rep.time_field = ftime->name;
+  if (f.ring) rep.has_ring = true;
+  if (f.time) rep.time_field = f.time->name;
+  return f;
+}
 
-  // Over the limit: input point k (row-major index) is read when floor(k * kept / n) steps up, which happens for
-  // exactly `kept` of the n indices, spread evenly (128-bit products: k * kept may pass 2^64 for huge messages).
-  const std::size_t kept = options.max_points > 0 && n > options.max_points ? options.max_points : n;
-  rep.thinned = kept < n;
+// The points (raw intensities, rings) and raw times of the message, thinned to `kept` of its n points spread evenly,
+// without the non-finite ones; returns the largest raw intensity.
+double readPoints(const sensor_msgs::PointCloud2& msg, const CloudFields& f, std::size_t kept, PointCloud& cloud,
+                  std::vector<double>& times, CloudConversionReport& rep) {
+  const std::size_t width = msg.width, height = msg.height;
+  const std::size_t n = width * height;
+  // Input point k (row-major index) is read when floor(k * kept / n) steps up, which happens for exactly `kept` of the
+  // n indices (128-bit products: k * kept may pass 2^64 for huge messages).
   const auto read = [&](std::size_t k) {
     return kept == n ||
            (static_cast<unsigned __int128>(k) * kept) / n != (static_cast<unsigned __int128>(k + 1) * kept) / n;
   };
-
   cloud.points.reserve(kept);
-  std::vector<double> times;
-  if (ftime) times.reserve(kept);
-  if (fring) cloud.ring.reserve(kept);
-
+  if (f.time) times.reserve(kept);
+  if (f.ring) cloud.ring.reserve(kept);
   double raw_max = 0.0;
   for (std::size_t row = 0; row < height; ++row) {
     const std::uint8_t* row_ptr = msg.data.data() + row * msg.row_step;
@@ -209,70 +210,99 @@ PointCloud toCloud(const sensor_msgs::PointCloud2& msg, const CloudConversionOpt
       // Finiteness is checked after the conversion to float: a float64 coordinate beyond float's range (1e300) is as
       // unusable as a NaN.
       Point pt;
-      pt.x = toFloat(fx->read(p));
-      pt.y = toFloat(fy->read(p));
-      pt.z = toFloat(fz->read(p));
+      pt.x = toFloat(f.x.read(p));
+      pt.y = toFloat(f.y.read(p));
+      pt.z = toFloat(f.z.read(p));
       if (!std::isfinite(pt.x) || !std::isfinite(pt.y) || !std::isfinite(pt.z)) {
         ++rep.dropped_nonfinite;
         continue;
       }
-      if (fi) {
-        const float v = toFloat(fi->read(p));
+      if (f.intensity) {
+        const float v = toFloat(f.intensity->read(p));
         // A non-finite intensity is a sensor glitch on a valid point: keep the point, with intensity 0.
         pt.intensity = std::isfinite(v) ? v : 0.0f;
         raw_max = std::max(raw_max, static_cast<double>(pt.intensity));
       }
       cloud.points.push_back(pt);
-      if (fring) {
-        const double r = fring->read(p);
+      if (f.ring) {
+        const double r = f.ring->read(p);
         cloud.ring.push_back(static_cast<std::uint16_t>(std::clamp(std::isfinite(r) ? r : 0.0, 0.0, 65535.0)));
       }
-      if (ftime) {
-        const double t = ftime->read(p);
+      if (f.time) {
+        const double t = f.time->read(p);
         times.push_back(std::isfinite(t) ? t : 0.0);
       }
     }
   }
+  return raw_max;
+}
+
+// Intensities into [0, 1] by the divisor the scaling asks for (recorded in the report).
+void scaleIntensities(PointCloud& cloud, std::uint8_t datatype, double raw_max, const CloudConversionOptions& options,
+                      CloudConversionReport& rep) {
+  double divisor = 1.0;
+  switch (options.intensity_scaling) {
+    case IntensityScaling::Auto:
+      divisor = isFloat(datatype) ? (raw_max > 1.0 ? raw_max : 1.0) : datatypeMax(datatype);
+      break;
+    case IntensityScaling::DatatypeRange:
+      divisor = isFloat(datatype) ? 1.0 : datatypeMax(datatype);
+      break;
+    case IntensityScaling::ObservedMax:
+      divisor = raw_max > 0.0 ? raw_max : 1.0;
+      break;
+    case IntensityScaling::FixedScale:
+      divisor = options.intensity_scale;
+      break;
+  }
+  rep.intensity_divisor = divisor;
+  // Divided in double: 1 / divisor in float overflows for a tiny FixedScale divisor (0 * inf = NaN intensities).
+  for (auto& pt : cloud.points) pt.intensity = static_cast<float>(std::clamp(pt.intensity / divisor, 0.0, 1.0));
+}
+
+// Per-point times as seconds within the sweep: integer times are nanoseconds (Ouster `t`), float times seconds
+// (velodyne `time`); absolute stamps (e.g. Hesai's float64 `timestamp`) become offsets from the header stamp (or the
+// earliest time when the stamp is 0).
+void setPointTimes(PointCloud& cloud, const std::vector<double>& times, std::uint8_t datatype, double stamp) {
+  const double to_seconds = isFloat(datatype) ? 1.0 : 1e-9;
+  double origin = 0.0;
+  const bool absolute = std::any_of(times.begin(), times.end(), [&](double t) { return t * to_seconds > 1e6; });
+  if (absolute) {
+    origin = stamp;
+    if (origin == 0.0) origin = *std::min_element(times.begin(), times.end()) * to_seconds;
+  }
+  cloud.time.resize(times.size());
+  for (std::size_t i = 0; i < times.size(); ++i) {
+    const float t = toFloat(times[i] * to_seconds - origin);
+    cloud.time[i] = std::isfinite(t) ? t : 0.0f;  // like a non-finite raw time: an offset beyond float's range
+  }
+}
+
+}  // namespace
+
+PointCloud toCloud(const sensor_msgs::PointCloud2& msg, const CloudConversionOptions& options,
+                   CloudConversionReport* report) {
+  CloudConversionReport local_report;
+  CloudConversionReport& rep = report ? *report : local_report;
+  rep = CloudConversionReport{};
+
+  PointCloud cloud;
+  const std::size_t n = static_cast<std::size_t>(msg.width) * msg.height;
+  rep.input_points = n;
+  // An empty message (even a default-constructed one without fields) is a valid empty scan.
+  if (n == 0) return cloud;
+  checkCloudLayout(msg, options);
+  const CloudFields fields = findCloudFields(msg, options, rep);
+
+  // Over the limit: `kept` of the n points, spread evenly.
+  const std::size_t kept = options.max_points > 0 && n > options.max_points ? options.max_points : n;
+  rep.thinned = kept < n;
+  std::vector<double> times;
+  const double raw_max = readPoints(msg, fields, kept, cloud, times, rep);
   rep.output_points = cloud.points.size();
   rep.raw_intensity_max = raw_max;
-
-  if (fi) {
-    double divisor = 1.0;
-    switch (options.intensity_scaling) {
-      case IntensityScaling::Auto:
-        divisor = isFloat(fi->datatype) ? (raw_max > 1.0 ? raw_max : 1.0) : datatypeMax(fi->datatype);
-        break;
-      case IntensityScaling::DatatypeRange:
-        divisor = isFloat(fi->datatype) ? 1.0 : datatypeMax(fi->datatype);
-        break;
-      case IntensityScaling::ObservedMax:
-        divisor = raw_max > 0.0 ? raw_max : 1.0;
-        break;
-      case IntensityScaling::FixedScale:
-        divisor = options.intensity_scale;
-        break;
-    }
-    rep.intensity_divisor = divisor;
-    // Divided in double: 1 / divisor in float overflows for a tiny FixedScale divisor (0 * inf = NaN intensities).
-    for (auto& pt : cloud.points) pt.intensity = static_cast<float>(std::clamp(pt.intensity / divisor, 0.0, 1.0));
-  }
-
-  if (ftime) {
-    // Integer times are nanoseconds (Ouster `t`), float times seconds (velodyne `time`).
-    const double to_seconds = isFloat(ftime->datatype) ? 1.0 : 1e-9;
-    double origin = 0.0;
-    // Absolute stamps (e.g. Hesai's float64 `timestamp`) become offsets within the sweep.
-    const bool absolute = std::any_of(times.begin(), times.end(), [&](double t) { return t * to_seconds > 1e6; });
-    if (absolute) {
-      origin = msg.header.stamp.toSec();
-      if (origin == 0.0) origin = *std::min_element(times.begin(), times.end()) * to_seconds;
-    }
-    cloud.time.resize(times.size());
-    for (std::size_t i = 0; i < times.size(); ++i) {
-      const float t = toFloat(times[i] * to_seconds - origin);
-      cloud.time[i] = std::isfinite(t) ? t : 0.0f;  // like a non-finite raw time: an offset beyond float's range
-    }
-  }
+  if (fields.intensity) scaleIntensities(cloud, fields.intensity->datatype, raw_max, options, rep);
+  if (fields.time) setPointTimes(cloud, times, fields.time->datatype, msg.header.stamp.toSec());
   return cloud;
 }
 

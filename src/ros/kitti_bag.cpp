@@ -330,158 +330,197 @@ struct CloudSeen {
   std::string frame;
 };
 
+// Reads a bag message by message and lists what is wrong in the report: types, stamps, transforms, point fields.
+class BagChecker {
+ public:
+  BagChecker(CheckReport& report, double duration)
+      : report_(report),
+        problems_(report),
+        // tf2 keeps the whole bag: its cache must span the bag's duration.
+        tf_buffer_(ros::Duration(std::max(10.0, duration + 10.0))) {}
+
+  // A damaged chunk (bad compression) ends the reading with a problem rather than an exception: the report still
+  // lists what came before it. A damaged message is listed, and the reading goes on (readListed).
+  void read(rosbag::View& view) {
+    std::size_t messages_read = 0;
+    try {
+      for (const rosbag::MessageInstance& m : view) {
+        ++messages_read;
+        if (!countAndCheckType(m)) continue;
+        const std::string& topic = m.getTopic();
+        if (topic == kTfTopic || topic == kTfStaticTopic) {
+          transforms(m, messages_read);
+        } else if (topic == kPointsTopic) {
+          cloud(m, messages_read);
+        } else if (topic == kGroundTruthTopic) {
+          groundTruth(m, messages_read);
+        }
+      }
+    } catch (const std::exception& e) {
+      problems_.add("damaged bag: reading stopped (" + std::to_string(messages_read) + " messages read): " + e.what());
+    }
+    report_.clouds = clouds_.size();
+  }
+
+  // What the whole bag says: its topics, a transform for every cloud, ground truth without clouds.
+  void finish(const std::string& fixed_frame) {
+    for (const auto& [name, ts] : topics_) report_.topics.push_back(ts);
+    if (!topics_.count(kPointsTopic)) {
+      std::string others;
+      for (const auto& [name, ts] : topics_) {
+        if (ts.datatype == "sensor_msgs/PointCloud2") others += " " + name;
+      }
+      problems_.add(std::string("no ") + kPointsTopic + " topic" +
+                    (others.empty() ? "" : " (PointCloud2 on:" + others + "; ret3d reads " + kPointsTopic + ")"));
+    }
+    // Every cloud must be placeable in the fixed frame at its own stamp (what the tracker does online).
+    for (const CloudSeen& c : clouds_) {
+      if (c.frame.empty() || c.frame == fixed_frame) continue;
+      std::string error;
+      if (!tf_buffer_.canTransform(fixed_frame, c.frame, c.stamp, &error)) {
+        problems_.add("cloud " + std::to_string(c.index) + " (stamp " + stampString(c.stamp) + "): no transform " +
+                      fixed_frame + " -> " + c.frame + " at its stamp: " + error);
+      }
+    }
+    std::size_t gt_without_cloud = 0;
+    for (double s : gt_stamps_) {
+      if (!cloud_stamps_.count(s)) ++gt_without_cloud;
+    }
+    if (gt_without_cloud > 0) {
+      report_.notes.push_back(std::to_string(gt_without_cloud) + " of " + std::to_string(gt_stamps_.size()) + " " +
+                              kGroundTruthTopic + " messages have no cloud with the same stamp");
+    }
+    if (!topics_.count(kGroundTruthTopic)) {
+      report_.notes.push_back(std::string("no ") + kGroundTruthTopic + ": fine for detection, not for evaluation");
+    }
+    if (!clouds_.empty() && report_.max_points == 0) report_.notes.push_back("every cloud is empty");
+  }
+
+ private:
+  // Counts the message under its topic; false when the topic is not one ret3d reads or has another type (listed
+  // once per topic).
+  bool countAndCheckType(const rosbag::MessageInstance& m) {
+    static const std::map<std::string, std::string> kExpectedTypes = {{kPointsTopic, "sensor_msgs/PointCloud2"},
+                                                                      {kTfTopic, "tf2_msgs/TFMessage"},
+                                                                      {kTfStaticTopic, "tf2_msgs/TFMessage"},
+                                                                      {kGroundTruthTopic, "ret3d/Object3DArray"}};
+    const std::string& topic = m.getTopic();
+    TopicSummary& ts = topics_[topic];
+    if (ts.count == 0) {
+      ts.topic = topic;
+      ts.datatype = m.getDataType();
+      ts.first_stamp = m.getTime().toSec();
+    }
+    ++ts.count;
+    ts.last_stamp = m.getTime().toSec();
+    const auto expected = kExpectedTypes.find(topic);
+    if (expected == kExpectedTypes.end()) return false;
+    if (m.getDataType() != expected->second) {
+      if (wrong_type_reported_.insert(topic).second) {
+        problems_.add(topic + " has type " + m.getDataType() + ", expected " + expected->second);
+      }
+      return false;
+    }
+    return true;
+  }
+
+  // /tf and /tf_static: into the tf2 buffer; a dynamic transform going back in time or one tf2 rejects is listed.
+  void transforms(const rosbag::MessageInstance& m, std::size_t number) {
+    const std::string& topic = m.getTopic();
+    const bool is_static = topic == kTfStaticTopic;
+    const auto tf = readListed<tf2_msgs::TFMessage>(m, number, problems_);
+    if (!tf) return;
+    for (const auto& t : tf->transforms) {
+      if (!is_static) {
+        auto& last = last_tf_stamp_[t.child_frame_id];
+        if (t.header.stamp < last) {
+          problems_.add(topic + ": transform " + t.header.frame_id + " -> " + t.child_frame_id + " at " +
+                        stampString(t.header.stamp) + " goes back in time (previous " + stampString(last) + ")");
+        }
+        last = t.header.stamp;
+      }
+      if (!tf_buffer_.setTransform(t, "bag", is_static)) {
+        problems_.add(topic + ": transform " + t.header.frame_id + " -> " + t.child_frame_id + " at " +
+                      stampString(t.header.stamp) + " rejected by tf2 (empty frame, NaN or self-transform)");
+      }
+    }
+  }
+
+  // A cloud: increasing stamps, a frame, x / y / z and an intensity field, readable by toCloud (its point count).
+  void cloud(const rosbag::MessageInstance& m, std::size_t number) {
+    const auto msg = readListed<sensor_msgs::PointCloud2>(m, number, problems_);
+    if (!msg) return;
+    const std::size_t index = clouds_.size();
+    const std::string where = "cloud " + std::to_string(index) + " (stamp " + stampString(msg->header.stamp) + ")";
+    if (index > 0 && msg->header.stamp <= last_cloud_stamp_) {
+      problems_.add(where + ": stamp not after the previous cloud's " + stampString(last_cloud_stamp_));
+    }
+    last_cloud_stamp_ = msg->header.stamp;
+    if (msg->header.frame_id.empty()) problems_.add(where + ": empty frame_id");
+    std::set<std::string> names;
+    for (const auto& f : msg->fields) names.insert(f.name);
+    for (const char* f : {"x", "y", "z"}) {
+      if (!names.count(f)) problems_.add(where + ": no field '" + std::string(f) + "'");
+    }
+    if (!names.count("intensity") && !names.count("i") && !names.count("reflectivity")) {
+      problems_.add(where + ": no intensity field (intensity, i or reflectivity)");
+    }
+    try {
+      const std::size_t n = toCloud(*msg).size();
+      report_.min_points = sized_clouds_ == 0 ? n : std::min(report_.min_points, n);
+      ++sized_clouds_;
+      report_.max_points = std::max(report_.max_points, n);
+    } catch (const std::invalid_argument& e) {
+      if (names.count("x") && names.count("y") && names.count("z")) problems_.add(where + ": " + e.what());
+    }
+    clouds_.push_back({index, msg->header.stamp, msg->header.frame_id});
+    cloud_stamps_.insert(msg->header.stamp.toSec());
+  }
+
+  // A ground-truth message: increasing stamps and a frame.
+  void groundTruth(const rosbag::MessageInstance& m, std::size_t number) {
+    const std::string& topic = m.getTopic();
+    const auto msg = readListed<ret3d::Object3DArray>(m, number, problems_);
+    if (!msg) return;
+    const std::size_t gt_count = gt_stamps_.size();
+    if (gt_count > 0 && msg->header.stamp <= last_gt_stamp_) {
+      problems_.add(topic + " message " + std::to_string(gt_count) + " (stamp " + stampString(msg->header.stamp) +
+                    "): stamp not after the previous one's " + stampString(last_gt_stamp_));
+    }
+    last_gt_stamp_ = msg->header.stamp;
+    if (msg->header.frame_id.empty()) {
+      problems_.add(topic + " message " + std::to_string(gt_count) + ": empty frame_id");
+    }
+    gt_stamps_.push_back(msg->header.stamp.toSec());
+  }
+
+  CheckReport& report_;
+  ProblemList problems_;
+  tf2::BufferCore tf_buffer_;
+  std::map<std::string, TopicSummary> topics_;
+  std::set<std::string> wrong_type_reported_;
+  std::map<std::string, ros::Time> last_tf_stamp_;  // per child frame
+  std::vector<CloudSeen> clouds_;
+  std::set<double> cloud_stamps_;
+  ros::Time last_cloud_stamp_, last_gt_stamp_;
+  std::size_t sized_clouds_ = 0;
+  std::vector<double> gt_stamps_;
+};
+
 }  // namespace
 
 CheckReport checkBag(const std::string& path, const std::string& fixed_frame) {
   CheckReport report;
   report.bag = path;
-  ProblemList problems(report);
-
   rosbag::Bag bag;
   openCheckedBag(bag, path);
   rosbag::View view(bag);
   const ros::Time begin = view.size() > 0 ? view.getBeginTime() : ros::Time();
   const ros::Time end = view.size() > 0 ? view.getEndTime() : ros::Time();
   report.duration = (end - begin).toSec();
-
-  const std::map<std::string, std::string> expected_types = {{kPointsTopic, "sensor_msgs/PointCloud2"},
-                                                             {kTfTopic, "tf2_msgs/TFMessage"},
-                                                             {kTfStaticTopic, "tf2_msgs/TFMessage"},
-                                                             {kGroundTruthTopic, "ret3d/Object3DArray"}};
-  std::map<std::string, TopicSummary> topics;
-  std::set<std::string> wrong_type_reported;
-
-  // tf2 keeps the whole bag: its cache must span the bag's duration.
-  tf2::BufferCore tf_buffer(ros::Duration(std::max(10.0, report.duration + 10.0)));
-  std::map<std::string, ros::Time> last_tf_stamp;  // per child frame
-  std::vector<CloudSeen> clouds;
-  std::set<double> cloud_stamps;
-  ros::Time last_cloud_stamp, last_gt_stamp;
-  std::size_t gt_count = 0, gt_without_cloud = 0, sized_clouds = 0;
-  std::vector<double> gt_stamps;
-
-  // A damaged chunk (bad compression) ends the reading with a problem rather than an exception: the report still
-  // lists what came before it. A damaged message is listed, and the reading goes on (readListed).
-  std::size_t messages_read = 0;
-  try {
-    for (const rosbag::MessageInstance& m : view) {
-      ++messages_read;
-      const std::string& topic = m.getTopic();
-      TopicSummary& ts = topics[topic];
-      if (ts.count == 0) {
-        ts.topic = topic;
-        ts.datatype = m.getDataType();
-        ts.first_stamp = m.getTime().toSec();
-      }
-      ++ts.count;
-      ts.last_stamp = m.getTime().toSec();
-
-      const auto expected = expected_types.find(topic);
-      if (expected == expected_types.end()) continue;
-      if (m.getDataType() != expected->second) {
-        if (wrong_type_reported.insert(topic).second) {
-          problems.add(topic + " has type " + m.getDataType() + ", expected " + expected->second);
-        }
-        continue;
-      }
-
-      if (topic == kTfTopic || topic == kTfStaticTopic) {
-        const bool is_static = topic == kTfStaticTopic;
-        const auto tf = readListed<tf2_msgs::TFMessage>(m, messages_read, problems);
-        if (!tf) continue;
-        for (const auto& t : tf->transforms) {
-          if (!is_static) {
-            auto& last = last_tf_stamp[t.child_frame_id];
-            if (t.header.stamp < last) {
-              problems.add(topic + ": transform " + t.header.frame_id + " -> " + t.child_frame_id + " at " +
-                           stampString(t.header.stamp) + " goes back in time (previous " + stampString(last) + ")");
-            }
-            last = t.header.stamp;
-          }
-          if (!tf_buffer.setTransform(t, "bag", is_static)) {
-            problems.add(topic + ": transform " + t.header.frame_id + " -> " + t.child_frame_id + " at " +
-                         stampString(t.header.stamp) + " rejected by tf2 (empty frame, NaN or self-transform)");
-          }
-        }
-      } else if (topic == kPointsTopic) {
-        const auto msg = readListed<sensor_msgs::PointCloud2>(m, messages_read, problems);
-        if (!msg) continue;
-        const std::size_t index = clouds.size();
-        const std::string where = "cloud " + std::to_string(index) + " (stamp " + stampString(msg->header.stamp) + ")";
-        if (index > 0 && msg->header.stamp <= last_cloud_stamp) {
-          problems.add(where + ": stamp not after the previous cloud's " + stampString(last_cloud_stamp));
-        }
-        last_cloud_stamp = msg->header.stamp;
-        if (msg->header.frame_id.empty()) problems.add(where + ": empty frame_id");
-        std::set<std::string> names;
-        for (const auto& f : msg->fields) names.insert(f.name);
-        for (const char* f : {"x", "y", "z"}) {
-          if (!names.count(f)) problems.add(where + ": no field '" + std::string(f) + "'");
-        }
-        if (!names.count("intensity") && !names.count("i") && !names.count("reflectivity")) {
-          problems.add(where + ": no intensity field (intensity, i or reflectivity)");
-        }
-        try {
-          const std::size_t n = toCloud(*msg).size();
-          report.min_points = sized_clouds == 0 ? n : std::min(report.min_points, n);
-          ++sized_clouds;
-          report.max_points = std::max(report.max_points, n);
-        } catch (const std::invalid_argument& e) {
-          if (names.count("x") && names.count("y") && names.count("z")) problems.add(where + ": " + e.what());
-        }
-        clouds.push_back({index, msg->header.stamp, msg->header.frame_id});
-        cloud_stamps.insert(msg->header.stamp.toSec());
-      } else if (topic == kGroundTruthTopic) {
-        const auto msg = readListed<ret3d::Object3DArray>(m, messages_read, problems);
-        if (!msg) continue;
-        if (gt_count > 0 && msg->header.stamp <= last_gt_stamp) {
-          problems.add(topic + " message " + std::to_string(gt_count) + " (stamp " + stampString(msg->header.stamp) +
-                       "): stamp not after the previous one's " + stampString(last_gt_stamp));
-        }
-        last_gt_stamp = msg->header.stamp;
-        if (msg->header.frame_id.empty()) {
-          problems.add(topic + " message " + std::to_string(gt_count) + ": empty frame_id");
-        }
-        gt_stamps.push_back(msg->header.stamp.toSec());
-        ++gt_count;
-      }
-    }
-  } catch (const std::exception& e) {
-    problems.add("damaged bag: reading stopped (" + std::to_string(messages_read) + " messages read): " + e.what());
-  }
-  report.clouds = clouds.size();
-
-  for (const auto& [name, ts] : topics) report.topics.push_back(ts);
-  if (!topics.count(kPointsTopic)) {
-    std::string others;
-    for (const auto& [name, ts] : topics) {
-      if (ts.datatype == "sensor_msgs/PointCloud2") others += " " + name;
-    }
-    problems.add(std::string("no ") + kPointsTopic + " topic" +
-                 (others.empty() ? "" : " (PointCloud2 on:" + others + "; ret3d reads " + kPointsTopic + ")"));
-  }
-
-  // Every cloud must be placeable in the fixed frame at its own stamp (what the tracker does online).
-  for (const CloudSeen& c : clouds) {
-    if (c.frame.empty() || c.frame == fixed_frame) continue;
-    std::string error;
-    if (!tf_buffer.canTransform(fixed_frame, c.frame, c.stamp, &error)) {
-      problems.add("cloud " + std::to_string(c.index) + " (stamp " + stampString(c.stamp) + "): no transform " +
-                   fixed_frame + " -> " + c.frame + " at its stamp: " + error);
-    }
-  }
-
-  for (double s : gt_stamps) {
-    if (!cloud_stamps.count(s)) ++gt_without_cloud;
-  }
-  if (gt_without_cloud > 0) {
-    report.notes.push_back(std::to_string(gt_without_cloud) + " of " + std::to_string(gt_count) + " " +
-                           kGroundTruthTopic + " messages have no cloud with the same stamp");
-  }
-  if (!topics.count(kGroundTruthTopic)) {
-    report.notes.push_back(std::string("no ") + kGroundTruthTopic + ": fine for detection, not for evaluation");
-  }
-  if (!clouds.empty() && report.max_points == 0) report.notes.push_back("every cloud is empty");
+  BagChecker checker(report, report.duration);
+  checker.read(view);
+  checker.finish(fixed_frame);
   return report;
 }
 

@@ -202,6 +202,54 @@ void RayCaster::slotRay(const Eigen::Isometry3d& T, int column, int beam, const 
   }
 }
 
+namespace {
+
+// The sensor's response to a ray (from ray_org along ray_dir) that hit a surface with geometric normal ng at `range`:
+// whether a return comes back (drop-out, porous crowns, range limits, the detection floor) and its range and
+// intensity. Draws from rng in a fixed order.
+bool sensorResponse(const RayCaster& caster, const SensorModel& sensor, const Surface& surf,
+                    const Eigen::Vector3d& ray_org, const Eigen::Vector3d& ray_dir, const Eigen::Vector3d& ng,
+                    double range, HashRng& rng, double* r_out, double* inten_out) {
+  const double wd = ray_dir.normalized().dot(ng.normalized());
+  const double cos_inc = std::min(1.0, std::abs(wd));
+  const double keep = (1.0 - sensor.dropout) * (1.0 - surf.dropout) *
+                      (1.0 - sensor.far_dropout * range / sensor.max_range) *
+                      (cos_inc < 0.03 ? 0.0 : 1.0);
+  if (rng.uniform() >= keep) return false;
+  if (surf.porosity > 0 && rng.uniform() < surf.porosity) {
+    // Into the crown: the return comes from a leaf at a random depth before the next surface.
+    const Eigen::Vector3d wdir = ray_dir.normalized();
+    double depth = kPorousDepth;
+    caster.intersect(ray_org + wdir * (range + 1e-3), wdir, 0.0, kPorousDepth, &depth, nullptr);
+    range += rng.uniform() * depth;
+  }
+  const double r = range + sensor.range_noise_sigma * rng.normal();
+  if (r < sensor.min_range || r > sensor.max_range) return false;
+  const double signal = surf.reflectivity * std::pow(cos_inc, sensor.incidence_exponent) *
+                        std::exp(-sensor.range_attenuation * range) * sensor.intensity_gain;
+  double inten = std::clamp(signal + sensor.intensity_noise_sigma * rng.normal(), 0.0, 1.0);
+  if (inten < sensor.zero_intensity_below) inten = 0.0;
+  if (sensor.weak_return_zero_below > 0) {
+    // The detection floor (a draw only for weak returns, so brighter rays keep their noise).
+    const WeakReturn weak = weakReturn(sensor, signal);
+    if (weak.zero) inten = 0.0;
+    if (weak.lost > 0 && rng.uniform() < weak.lost) return false;
+  }
+  if (sensor.zero_intensity_near > 0 || sensor.zero_intensity_far > 0) {
+    const double ramp = std::clamp((r - sensor.zero_intensity_near_range) /
+                                       (sensor.zero_intensity_far_range - sensor.zero_intensity_near_range),
+                                   0.0, 1.0);
+    const double p0 =
+        sensor.zero_intensity_near + (sensor.zero_intensity_far - sensor.zero_intensity_near) * ramp;
+    if (rng.uniform() < p0) inten = 0.0;
+  }
+  *r_out = r;
+  *inten_out = inten;
+  return true;
+}
+
+}  // namespace
+
 Sweep RayCaster::cast(const Eigen::Isometry3d& T, std::uint64_t seed, int frame, const Eigen::Vector3d& ego_velocity,
                       double yaw_rate) const {
   const Impl& m = *impl_;
@@ -273,41 +321,12 @@ Sweep RayCaster::cast(const Eigen::Isometry3d& T, std::uint64_t seed, int frame,
             // Per-ray randomness from (seed, frame, slot): independent of threads and order.
             HashRng rng(seed, static_cast<std::uint64_t>(frame), slot);
             const Eigen::Vector3d d = m.dirs[slot].cast<double>();
-            const double wd = Eigen::Vector3d(rh.ray.dir_x[k], rh.ray.dir_y[k], rh.ray.dir_z[k]).normalized().dot(ng.normalized());
-            const double cos_inc = std::min(1.0, std::abs(wd));
-            const double keep = (1.0 - sensor_.dropout) * (1.0 - surf.dropout) *
-                                (1.0 - sensor_.far_dropout * range / sensor_.max_range) *
-                                (cos_inc < 0.03 ? 0.0 : 1.0);
-            if (rng.uniform() >= keep) continue;
-            if (surf.porosity > 0 && rng.uniform() < surf.porosity) {
-              // Into the crown: the return comes from a leaf at a random depth before the next surface.
-              const Eigen::Vector3d o(rh.ray.org_x[k], rh.ray.org_y[k], rh.ray.org_z[k]);
-              const Eigen::Vector3d wdir =
-                  Eigen::Vector3d(rh.ray.dir_x[k], rh.ray.dir_y[k], rh.ray.dir_z[k]).normalized();
-              double depth = kPorousDepth;
-              intersect(o + wdir * (range + 1e-3), wdir, 0.0, kPorousDepth, &depth, nullptr);
-              range += rng.uniform() * depth;
-            }
-            const double r = range + sensor_.range_noise_sigma * rng.normal();
-            if (r < sensor_.min_range || r > sensor_.max_range) continue;
-            const double signal = surf.reflectivity * std::pow(cos_inc, sensor_.incidence_exponent) *
-                                  std::exp(-sensor_.range_attenuation * range) * sensor_.intensity_gain;
-            double inten = std::clamp(signal + sensor_.intensity_noise_sigma * rng.normal(), 0.0, 1.0);
-            if (inten < sensor_.zero_intensity_below) inten = 0.0;
-            if (sensor_.weak_return_zero_below > 0) {
-              // The detection floor (a draw only for weak returns, so brighter rays keep their noise).
-              const WeakReturn weak = weakReturn(sensor_, signal);
-              if (weak.zero) inten = 0.0;
-              if (weak.lost > 0 && rng.uniform() < weak.lost) continue;
-            }
-            if (sensor_.zero_intensity_near > 0 || sensor_.zero_intensity_far > 0) {
-              const double ramp = std::clamp((r - sensor_.zero_intensity_near_range) /
-                                                 (sensor_.zero_intensity_far_range - sensor_.zero_intensity_near_range),
-                                             0.0, 1.0);
-              const double p0 =
-                  sensor_.zero_intensity_near + (sensor_.zero_intensity_far - sensor_.zero_intensity_near) * ramp;
-              if (rng.uniform() < p0) inten = 0.0;
-            }
+            double r = 0, inten = 0;
+            if (!sensorResponse(*this, sensor_, surf,
+                                Eigen::Vector3d(rh.ray.org_x[k], rh.ray.org_y[k], rh.ray.org_z[k]),
+                                Eigen::Vector3d(rh.ray.dir_x[k], rh.ray.dir_y[k], rh.ray.dir_z[k]), ng, range, rng, &r,
+                                &inten))
+              continue;
             Point& p = sw.points[slot];
             p.x = static_cast<float>(d.x() * r);
             p.y = static_cast<float>(d.y() * r);

@@ -71,17 +71,11 @@ struct Totals {
   double matching_s = 0, pipeline_s = 0, smoothing_s = 0;
 };
 
-void labelSequence(const AutolabelArgs& a, const kitti::TrackingDataset& ds, const std::string& seq,
-                   pipeline::OfflinePipeline* p, Totals* totals) {
-  const fs::path out = fs::path(a.out) / "training";
-  const std::vector<int> frames = ds.frames(seq);
-  if (frames.empty()) {
-    RET3D_WARN("sequence " << seq << ": no scans; skipped");
-    return;
-  }
-  if (ds.isScanFolder())
-    RET3D_WARN(ds.dir() << ": a folder of scans without calibration; the KITTI default is written");
-  const kitti::Calibration calib = ds.calibration(seq);
+// The sequence's LiDAR poses: given (pose/, OXTS), else estimated by scan matching, else (--no-scan-matching)
+// identities; *have_poses says whether they are real.
+std::vector<Eigen::Isometry3d> sequencePoses(const AutolabelArgs& a, const kitti::TrackingDataset& ds,
+                                             const std::string& seq, const std::vector<int>& frames, Totals* totals,
+                                             bool* have_poses) {
   std::vector<Eigen::Isometry3d> poses = ds.lidarPoses(seq);
   if (poses.empty()) {
     if (a.no_scan_matching) {
@@ -92,13 +86,21 @@ void labelSequence(const AutolabelArgs& a, const kitti::TrackingDataset& ds, con
       totals->matching_s += secondsSince(t0);
     }
   }
-  const bool have_poses = !poses.empty();
-  if (!have_poses) poses.assign(static_cast<std::size_t>(frames.back()) + 1, Eigen::Isometry3d::Identity());
+  *have_poses = !poses.empty();
+  if (!*have_poses) poses.assign(static_cast<std::size_t>(frames.back()) + 1, Eigen::Isometry3d::Identity());
   if (static_cast<int>(poses.size()) <= frames.back())
     throw std::runtime_error("sequence " + seq + ": " + std::to_string(poses.size()) +
                              " ego poses for scans up to frame " + std::to_string(frames.back()));
+  return poses;
+}
 
-  // The pipeline, online as in `ret3d detect`; its tracked boxes moved into the fixed frame of the first scan.
+// The pipeline, online as in `ret3d detect`; its tracked boxes moved into the fixed frame of the first scan, per
+// frame index. Links (or copies) each scan into OUT.
+std::vector<std::vector<Box>> trackedBoxesInWorld(const AutolabelArgs& a, const kitti::TrackingDataset& ds,
+                                                  const std::string& seq, const std::vector<int>& frames,
+                                                  const std::vector<Eigen::Isometry3d>& poses,
+                                                  pipeline::OfflinePipeline* p, Totals* totals) {
+  const fs::path out = fs::path(a.out) / "training";
   fs::create_directories(out / "velodyne" / seq);
   std::vector<std::vector<Box>> world(static_cast<std::size_t>(frames.back()) + 1);
   const auto t0 = Clock::now();
@@ -115,36 +117,67 @@ void labelSequence(const AutolabelArgs& a, const kitti::TrackingDataset& ds, con
   });
   totals->pipeline_s += secondsSince(t0);
   totals->frames += frames.size();
+  return world;
+}
 
-  const auto t1 = Clock::now();
-  TrackSmoothingStats stats;
-  const auto smoothed = smoothTracks(world, a.smoothing, &stats);
-  totals->smoothing_s += secondsSince(t1);
+// The smoothed boxes back in each scan's sensor frame as KITTI labels. A frame index without a scan (a gap in the
+// files) gets no labels: there is nothing to train on. Every box, also outside the camera's view: the detector trains
+// on the whole scan.
+std::vector<kitti::Label> sensorFrameLabels(const std::vector<std::vector<Box>>& smoothed, const std::vector<int>& frames,
+                                            const std::vector<Eigen::Isometry3d>& poses,
+                                            const kitti::Calibration& calib, Totals* totals) {
   std::vector<kitti::Label> labels;
-  // A frame index without a scan (a gap in the files) gets no labels: there is nothing to train on.
   for (const int f : frames) {
     const Eigen::Isometry3d to_sensor = poses[static_cast<std::size_t>(f)].inverse();
     std::vector<Box> boxes;
     for (const Box& b : smoothed[static_cast<std::size_t>(f)]) boxes.push_back(transformBox(b, to_sensor));
     countBoxes(boxes, &totals->smoothed);
-    // Every box, also outside the camera's view: the detector trains on the whole scan.
     for (const Box& b : boxes) {
       kitti::Label l = kitti::boxToLabel(b, calib);
       l.frame = f;
       labels.push_back(l);
     }
   }
-  kitti::writeTrackingLabels((out / "label_02" / (seq + ".txt")).string(), labels);
-  kitti::writeCalibration((out / "calib" / (seq + ".txt")).string(), calib);
+  return labels;
+}
+
+// OUT's pose file: the dataset's copied, else the poses used (camera poses in KITTI's odometry convention, the inverse
+// of kitti::cameraPosesToLidar) when they are real.
+void writeSequencePoses(const kitti::TrackingDataset& ds, const std::string& seq, const fs::path& out,
+                        const kitti::Calibration& calib, const std::vector<Eigen::Isometry3d>& poses, bool have_poses) {
   if (fs::exists(ds.posePath(seq))) {
     fs::copy_file(ds.posePath(seq), out / "pose" / (seq + ".txt"), fs::copy_options::overwrite_existing);
   } else if (have_poses) {
-    // Camera poses in KITTI's odometry convention, the inverse of kitti::cameraPosesToLidar.
     const Eigen::Isometry3d Tr = sim::lidarToCamera(calib), Tr_inv = Tr.inverse();
     std::vector<Eigen::Isometry3d> cam;
     for (const auto& P : poses) cam.push_back(Tr * P * Tr_inv);
     kitti::writePoses((out / "pose" / (seq + ".txt")).string(), cam);
   }
+}
+
+void labelSequence(const AutolabelArgs& a, const kitti::TrackingDataset& ds, const std::string& seq,
+                   pipeline::OfflinePipeline* p, Totals* totals) {
+  const fs::path out = fs::path(a.out) / "training";
+  const std::vector<int> frames = ds.frames(seq);
+  if (frames.empty()) {
+    RET3D_WARN("sequence " << seq << ": no scans; skipped");
+    return;
+  }
+  if (ds.isScanFolder())
+    RET3D_WARN(ds.dir() << ": a folder of scans without calibration; the KITTI default is written");
+  const kitti::Calibration calib = ds.calibration(seq);
+  bool have_poses = false;
+  const std::vector<Eigen::Isometry3d> poses = sequencePoses(a, ds, seq, frames, totals, &have_poses);
+  const std::vector<std::vector<Box>> world = trackedBoxesInWorld(a, ds, seq, frames, poses, p, totals);
+
+  const auto t1 = Clock::now();
+  TrackSmoothingStats stats;
+  const auto smoothed = smoothTracks(world, a.smoothing, &stats);
+  totals->smoothing_s += secondsSince(t1);
+  kitti::writeTrackingLabels((out / "label_02" / (seq + ".txt")).string(),
+                             sensorFrameLabels(smoothed, frames, poses, calib, totals));
+  kitti::writeCalibration((out / "calib" / (seq + ".txt")).string(), calib);
+  writeSequencePoses(ds, seq, out, calib, poses, have_poses);
   std::cout << "sequence " << seq << ": " << stats.tracks_in << " tracks, " << stats.tracks_kept << " kept, "
             << stats.dropped_short << " dropped as shorter than " << a.smoothing.min_track_length << " frames, "
             << stats.dropped_score << " with a mean score below " << a.smoothing.min_track_score << "; "

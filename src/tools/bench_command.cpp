@@ -354,6 +354,33 @@ std::vector<double> baseTimes(const pipeline::OfflinePipeline& p) {
   return base;
 }
 
+// The timed runs: frames in order (then again, each pass a new stretch of time for the tracker) until warm-up plus
+// min_runs frames have run, the baseline interleaved frame by frame so a busy spell of the shared machine falls on
+// both alike. Returns the boxes of the timed runs.
+std::size_t timeFrames(const BenchArgs& a, const std::vector<BenchFrame>& frames, pipeline::OfflinePipeline& p,
+                       std::optional<pipeline::OfflinePipeline>& baseline) {
+  int runs = 0, pass = 0;
+  std::size_t boxes = 0;
+  while (runs < a.min_runs + a.warmup) {
+    p.reset();
+    if (baseline) baseline->reset();
+    for (std::size_t i = 0; i < frames.size() && runs < a.min_runs + a.warmup; ++i, ++runs) {
+      if (runs == a.warmup) p.clearTimes();
+      if (runs == a.warmup && baseline) baseline->clearTimes();
+      const BenchFrame& f = frames[i];
+      const bool prev = i > 0 && f.follows;
+      const Eigen::Isometry3d prev_to_current =
+          prev ? Eigen::Isometry3d(f.pose.inverse() * frames[i - 1].pose) : Eigen::Isometry3d::Identity();
+      const double stamp = 0.1 * static_cast<double>(i) + 1000.0 * pass;
+      const Detections d = p.run(&f.cloud, prev ? &frames[i - 1].cloud : nullptr, prev_to_current, {}, stamp, f.pose);
+      if (runs >= a.warmup) boxes += d.size();
+      if (baseline) baseline->run(&f.cloud, prev ? &frames[i - 1].cloud : nullptr, prev_to_current, {}, stamp, f.pose);
+    }
+    ++pass;
+  }
+  return boxes;
+}
+
 int runBench(BenchArgs a) {
   a.pipeline.stages = pipeline::parseStages(a.stages);
   if (a.nodelets.load < 0) throw std::runtime_error("--load must be >= 0, not " + std::to_string(a.nodelets.load));
@@ -384,27 +411,7 @@ int runBench(BenchArgs a) {
             << " timed runs; " << std::thread::hardware_concurrency() << " cores here\n";
   const std::optional<BusyLoad> busy = a.nodelets.load > 0 ? std::make_optional<BusyLoad>(a.nodelets.load) : std::nullopt;
   if (busy) std::cout << "bench: " << a.nodelets.load << " busy processes spinning (--load)\n";
-  int runs = 0, pass = 0;
-  std::size_t boxes = 0;
-  while (runs < a.min_runs + a.warmup) {
-    p.reset();
-    if (baseline) baseline->reset();
-    for (std::size_t i = 0; i < frames.size() && runs < a.min_runs + a.warmup; ++i, ++runs) {
-      if (runs == a.warmup) p.clearTimes();
-      if (runs == a.warmup && baseline) baseline->clearTimes();
-      const BenchFrame& f = frames[i];
-      const bool prev = i > 0 && f.follows;
-      const Eigen::Isometry3d prev_to_current =
-          prev ? Eigen::Isometry3d(f.pose.inverse() * frames[i - 1].pose) : Eigen::Isometry3d::Identity();
-      // Each pass is a new stretch of time for the tracker.
-      const double stamp = 0.1 * static_cast<double>(i) + 1000.0 * pass;
-      const Detections d = p.run(&f.cloud, prev ? &frames[i - 1].cloud : nullptr, prev_to_current, {}, stamp, f.pose);
-      if (runs >= a.warmup) boxes += d.size();
-      // Interleaved frame by frame, so a busy spell of the shared machine falls on both alike.
-      if (baseline) baseline->run(&f.cloud, prev ? &frames[i - 1].cloud : nullptr, prev_to_current, {}, stamp, f.pose);
-    }
-    ++pass;
-  }
+  const std::size_t boxes = timeFrames(a, frames, p, baseline);
   const auto& t = p.times().all();
   std::cout << std::left << std::setw(26) << "stage" << std::right << std::setw(12) << "median ms" << std::setw(12)
             << "p95 ms" << "\n";

@@ -106,9 +106,8 @@ int drawLine(BevImage& img, int col, int row, const TextLine& line, int scale) {
   return col;
 }
 
-int runDraw(DrawArgs a) {
+void checkDrawArgs(const DrawArgs& a, bool detector) {
   if (a.scan.empty() || a.out.empty()) throw std::invalid_argument("--scan and --out are required");
-  const bool detector = !a.pipeline.models.empty() || !a.pipeline.detector_model.empty();
   if (detector && !a.pred.empty())
     throw std::invalid_argument("--pred and a detector (--models/--detector-model) exclude each other: draw one set");
   if ((!a.labels.empty() || !a.pred.empty()) && a.calib.empty())
@@ -118,61 +117,68 @@ int runDraw(DrawArgs a) {
   if (a.view != "around" && a.view != "front")
     throw std::invalid_argument("--view: 'around' or 'front', not '" + a.view + "'");
   if (a.size < 100 || a.size > 8000) throw std::invalid_argument("--size: 100 to 8000 pixels");
+}
 
-  const PointCloud cloud = kitti::readVelodyne(a.scan);
-  std::optional<kitti::Calibration> calib;
-  if (!a.calib.empty()) calib = kitti::readCalibration(a.calib);
+// The boxes to draw and where they come from (for the legend).
+struct DrawnDetections {
+  std::vector<Box> boxes;
+  std::string source;  // empty: none drawn
+};
 
-  // The detections: the detector in-process (the same code path as `ret3d detect --stages base`, one sweep), or a
-  // result file.
-  std::vector<Box> dets;
-  std::string source;
-  BevView view;
-  if (detector) {
-    a.pipeline.stages = {"base"};
-    pipeline::OfflinePipeline p(withPackageDir(a.pipeline));
-    const Detections d = p.run(&cloud, nullptr, Eigen::Isometry3d::Identity(), {}, 0.0, Eigen::Isometry3d::Identity());
-    dets = d.boxes;
-    const BevGeometry g = p.detector()->options().inferenceGeometry();
-    view.x_min = g.x_min;
-    view.x_max = g.x_max;
-    view.y_min = g.y_min;
-    view.y_max = g.y_max;
-    const std::string model = a.pipeline.detector_model.empty() ? a.pipeline.models + "/detector.pt"
-                                                                : a.pipeline.detector_model;
-    const fs::path m(model);  // its folder and name say which model it is (models/lwd3d/detector.pt -> lwd3d/...)
-    source = "LWD-3D " + (m.parent_path().filename() / m.filename()).string() + ", score >= " +
+// The detector in-process (the same code path as `ret3d detect --stages base`, one sweep); `view` becomes its grid.
+DrawnDetections runDetector(DrawArgs& a, const PointCloud& cloud, BevView* view) {
+  DrawnDetections d;
+  a.pipeline.stages = {"base"};
+  pipeline::OfflinePipeline p(withPackageDir(a.pipeline));
+  d.boxes = p.run(&cloud, nullptr, Eigen::Isometry3d::Identity(), {}, 0.0, Eigen::Isometry3d::Identity()).boxes;
+  const BevGeometry g = p.detector()->options().inferenceGeometry();
+  view->x_min = g.x_min;
+  view->x_max = g.x_max;
+  view->y_min = g.y_min;
+  view->y_max = g.y_max;
+  const std::string model = a.pipeline.detector_model.empty() ? a.pipeline.models + "/detector.pt"
+                                                              : a.pipeline.detector_model;
+  const fs::path m(model);  // its folder and name say which model it is (models/lwd3d/detector.pt -> lwd3d/...)
+  d.source = "LWD-3D " + (m.parent_path().filename() / m.filename()).string() + ", score >= " +
              fixed(p.detector()->options().inference.score_threshold, 2);
-  } else if (!a.pred.empty()) {
-    dets = readBoxes(a.pred, *calib, nullptr);
-    if (a.pipeline.score_threshold >= 0)
-      dets.erase(std::remove_if(dets.begin(), dets.end(),
-                                [&](const Box& b) { return b.score < a.pipeline.score_threshold; }),
-                 dets.end());
-    source = fs::path(a.pred).filename().string();
-    if (a.pipeline.score_threshold >= 0) source += ", score >= " + fixed(a.pipeline.score_threshold, 2);
-  }
-  std::vector<Box> gt, gt_other;
-  if (!a.labels.empty()) gt = readBoxes(a.labels, *calib, &gt_other);
+  return d;
+}
 
+// A result file's boxes at or above --score-threshold.
+DrawnDetections readPredictions(const DrawArgs& a, const kitti::Calibration& calib) {
+  DrawnDetections d;
+  d.boxes = readBoxes(a.pred, calib, nullptr);
+  if (a.pipeline.score_threshold >= 0)
+    d.boxes.erase(std::remove_if(d.boxes.begin(), d.boxes.end(),
+                                 [&](const Box& b) { return b.score < a.pipeline.score_threshold; }),
+                  d.boxes.end());
+  d.source = fs::path(a.pred).filename().string();
+  if (a.pipeline.score_threshold >= 0) d.source += ", score >= " + fixed(a.pipeline.score_threshold, 2);
+  return d;
+}
+
+// --view front (KITTI's evaluated area in front of the car: camera 2 looks forward, 0-70 m ahead, 40 m to each side)
+// or --extent over the default view, and the scale for --size pixels.
+void applyViewArgs(const DrawArgs& a, BevView* view) {
   if (a.view == "front") {
-    // KITTI's evaluated area in front of the car (camera 2 looks forward): 0-70 m ahead, 40 m to each side.
-    view.x_min = 0.0;
-    view.x_max = 70.0;
-    view.y_min = -40.0;
-    view.y_max = 40.0;
+    view->x_min = 0.0;
+    view->x_max = 70.0;
+    view->y_min = -40.0;
+    view->y_max = 40.0;
   }
   if (!a.extent.empty()) {
     const auto e = parseExtent(a.extent);
-    view.x_min = e[0];
-    view.x_max = e[1];
-    view.y_min = e[2];
-    view.y_max = e[3];
+    view->x_min = e[0];
+    view->x_max = e[1];
+    view->y_min = e[2];
+    view->y_max = e[3];
   }
-  view.pixels_per_metre = a.size / std::max(view.x_max - view.x_min, view.y_max - view.y_min);
-  BevImage img(view);
+  view->pixels_per_metre = a.size / std::max(view->x_max - view->x_min, view->y_max - view->y_min);
+}
 
-  // Background: range rings every 10 m, the camera's field of view, then the points.
+// Background: range rings every 10 m, the camera's field of view, then the points.
+void drawBackground(BevImage& img, const PointCloud& cloud, const std::optional<kitti::Calibration>& calib,
+                    const std::string& shade) {
   for (int r = 10; r <= 150; r += 10) img.drawGroundCircle(0, 0, r, kRings);
   if (calib) {
     double left = 0, right = 0;
@@ -181,14 +187,18 @@ int runDraw(DrawArgs a) {
         img.drawGroundLine({0, 0}, {150 * std::cos(ang), 150 * std::sin(ang)}, kFov);
     }
   }
-  img.drawPoints(cloud, a.shade == "height" ? PointShade::Height : PointShade::Intensity);
+  img.drawPoints(cloud, shade == "height" ? PointShade::Height : PointShade::Intensity);
+}
 
-  // Ego vehicle (a car-sized box at the sensor, facing forward), ground truth, then detections on top.
+// Ego vehicle (a car-sized box at the sensor, facing forward), ground truth, then detections on top, each with its
+// score just right of its outline unless no_scores. Returns the detections per class.
+std::map<ObjectClass, int> drawBoxes(BevImage& img, double pixels_per_metre, const std::vector<Box>& gt,
+                                     const std::vector<Box>& gt_other, const std::vector<Box>& dets, bool no_scores) {
   Box ego;
   ego.length = 4.0;
   ego.width = 1.8;
   img.drawBox(ego, kEgo, 1, true);
-  const int thick = std::max(1, static_cast<int>(std::lround(view.pixels_per_metre / 8.0)));
+  const int thick = std::max(1, static_cast<int>(std::lround(pixels_per_metre / 8.0)));
   for (const Box& b : gt_other) img.drawBox(b, kOtherGt, thick, false);
   for (const Box& b : gt) img.drawBox(b, kWhite, thick + 2, false);
   std::map<ObjectClass, int> counts;
@@ -196,26 +206,28 @@ int runDraw(DrawArgs a) {
     const Rgb c = toRgb(classColour(b.label));
     img.drawBox(b, c, thick, true);
     ++counts[b.label];
-    if (!a.no_scores) {
-      // The score just right of the box's outline.
-      double col = -1e9, row = 1e9;
-      for (const auto& corner : bevCorners(b)) {
-        const Eigen::Vector2d px = img.toPixel(corner.x(), corner.y());
-        col = std::max(col, px.x());
-        row = std::min(row, px.y());
-      }
-      img.drawText(static_cast<int>(col) + 3, static_cast<int>(row), fixed(b.score, 2), c, 1);
+    if (no_scores) continue;
+    double col = -1e9, row = 1e9;
+    for (const auto& corner : bevCorners(b)) {
+      const Eigen::Vector2d px = img.toPixel(corner.x(), corner.y());
+      col = std::max(col, px.x());
+      row = std::min(row, px.y());
     }
+    img.drawText(static_cast<int>(col) + 3, static_cast<int>(row), fixed(b.score, 2), c, 1);
   }
+  return counts;
+}
 
-  // The legend in a band above the map, so it hides nothing: title, points and scale, detections, ground truth.
-  const int scale = img.width() >= 800 ? 2 : 1;
+// The legend's lines: title, points and scale, detections per class, ground truth.
+std::vector<TextLine> legendLines(const DrawArgs& a, std::size_t num_points, const DrawnDetections& d,
+                                  std::map<ObjectClass, int>& counts, std::size_t num_gt, std::size_t num_gt_other,
+                                  bool has_calib) {
   std::vector<TextLine> lines;
   lines.push_back({{a.title.empty() ? fs::path(a.scan).filename().string() : a.title, kText}});
   lines.push_back(
-      {{std::to_string(cloud.size()) + " points, grey by " + a.shade + "; rings every 10 m; scale bar 10 m", kText}});
-  if (!source.empty()) {
-    lines.push_back({{std::to_string(dets.size()) + " detections (" + source + "):", kText}});
+      {{std::to_string(num_points) + " points, grey by " + a.shade + "; rings every 10 m; scale bar 10 m", kText}});
+  if (!d.source.empty()) {
+    lines.push_back({{std::to_string(d.boxes.size()) + " detections (" + d.source + "):", kText}});
     TextLine per_class;
     for (const ObjectClass c : kDetectedClasses)
       per_class.push_back({std::string(className(c)) + " " + std::to_string(counts[c]) + " ", toRgb(classColour(c))});
@@ -223,28 +235,59 @@ int runDraw(DrawArgs a) {
     lines.push_back(per_class);
   }
   if (!a.labels.empty()) {
-    TextLine truth{{"ground truth " + std::to_string(gt.size()) + " ", kWhite}};
-    if (!gt_other.empty())
-      truth.push_back({"other labels, ignored " + std::to_string(gt_other.size()) + " ", kOtherGt});
-    if (calib) truth.push_back({"camera view (labelled area)", kFov});
+    TextLine truth{{"ground truth " + std::to_string(num_gt) + " ", kWhite}};
+    if (num_gt_other > 0) truth.push_back({"other labels, ignored " + std::to_string(num_gt_other) + " ", kOtherGt});
+    if (has_calib) truth.push_back({"camera view (labelled area)", kFov});
     lines.push_back(truth);
   }
+  return lines;
+}
+
+// The map under a band holding the legend, so the legend hides nothing; the scale bar after the second line.
+BevImage withLegend(const BevImage& img, const std::vector<TextLine>& lines, double pixels_per_metre) {
+  const int scale = img.width() >= 800 ? 2 : 1;
   const int line_h = BevImage::textHeight(scale) + 4 * scale;
   BevImage page(img.width(), static_cast<int>(lines.size()) * line_h + 4 * scale + img.height());
   for (std::size_t i = 0; i < lines.size(); ++i) {
     const int row = 3 * scale + static_cast<int>(i) * line_h;
     const int end = drawLine(page, 3 * scale, row, lines[i], scale);
     if (i == 1) {  // the scale bar after "10 m:"
-      const int bar_px = static_cast<int>(std::lround(10.0 * view.pixels_per_metre));
+      const int bar_px = static_cast<int>(std::lround(10.0 * pixels_per_metre));
       page.fillRect(end, row + BevImage::textHeight(scale) / 2 - scale, bar_px, 2 * scale, kText);
     }
   }
   page.paste(img, 0, page.height() - img.height());
+  return page;
+}
+
+int runDraw(DrawArgs a) {
+  const bool detector = !a.pipeline.models.empty() || !a.pipeline.detector_model.empty();
+  checkDrawArgs(a, detector);
+  const PointCloud cloud = kitti::readVelodyne(a.scan);
+  std::optional<kitti::Calibration> calib;
+  if (!a.calib.empty()) calib = kitti::readCalibration(a.calib);
+
+  BevView view;
+  DrawnDetections dets;
+  if (detector)
+    dets = runDetector(a, cloud, &view);
+  else if (!a.pred.empty())
+    dets = readPredictions(a, *calib);
+  std::vector<Box> gt, gt_other;
+  if (!a.labels.empty()) gt = readBoxes(a.labels, *calib, &gt_other);
+  applyViewArgs(a, &view);
+
+  BevImage img(view);
+  drawBackground(img, cloud, calib, a.shade);
+  std::map<ObjectClass, int> counts = drawBoxes(img, view.pixels_per_metre, gt, gt_other, dets.boxes, a.no_scores);
+  const BevImage page = withLegend(
+      img, legendLines(a, cloud.size(), dets, counts, gt.size(), gt_other.size(), calib.has_value()),
+      view.pixels_per_metre);
 
   if (fs::path(a.out).has_parent_path()) fs::create_directories(fs::path(a.out).parent_path());
   page.writePng(a.out);
   std::cout << "draw: " << a.out << " (" << page.width() << " x " << page.height() << "), " << cloud.size()
-            << " points, " << dets.size() << " detections";
+            << " points, " << dets.boxes.size() << " detections";
   if (!a.labels.empty()) std::cout << ", " << gt.size() << " ground-truth boxes";
   std::cout << std::endl;
   return 0;

@@ -74,14 +74,12 @@ int runCompare(const SimArgs& args) {
   return 0;
 }
 
-int runSim(const SimArgs& args) {
+// The simulator's options from the arguments: the scenario, the sensor (a YAML path, or a name under config/sensors
+// next to the scenario's config/sim), the output, frames, seed and replay.
+sim::SimOptions simOptions(const SimArgs& args) {
   namespace fs = std::filesystem;
-  if (!args.compare.empty()) return runCompare(args);
-  if (!args.stats.empty()) return runStats(args);
-  if (args.config.empty() || args.out.empty()) throw std::runtime_error("--config and --out are required");
   sim::SimOptions opt;
   opt.config = sim::loadSimConfig(args.config);
-  // Sensor: a YAML path, or a name under config/sensors next to the scenario's config/sim.
   const std::string sensor = args.sensor.empty() ? opt.config.sensor : args.sensor;
   if (fs::path(sensor).extension() == ".yaml") {
     opt.sensor = sim::loadSensorModel(sensor);
@@ -95,26 +93,11 @@ int runSim(const SimArgs& args) {
   opt.threads = args.threads;
   opt.replay_dir = args.replay;
   opt.replay_sequence = args.replay_sequence;
-  if (args.sequences < 1) throw std::runtime_error("--sequences must be at least 1");
-  if (args.frames < 1 && args.replay.empty()) throw std::runtime_error("--frames must be at least 1");
-  const int sequences = args.replay.empty() ? args.sequences : 1;
-  fs::create_directories(args.out);
+  return opt;
+}
 
-  std::cout << "ret3d sim: " << opt.config.name << " (" << args.config << "), sensor " << opt.sensor.name << " ("
-            << opt.sensor.beams() << " beams x " << opt.sensor.columns() << " columns), " << sequences
-            << " sequence(s)" << (args.replay.empty() ? " x " + std::to_string(args.frames) + " frames" : ", replay of " + args.replay + " " + args.replay_sequence)
-            << ", seed " << args.seed << " -> " << args.out << std::endl;
-  ProgressBar bar("sim", static_cast<std::size_t>(sequences) * static_cast<std::size_t>(std::max(args.frames, 1)));
-  std::vector<sim::SequenceReport> reports;
-  for (int s = 0; s < sequences; ++s) {
-    reports.push_back(sim::simulateSequence(opt, s, [&](const sim::FrameReport& f) {
-      bar.tick(1, "seq " + std::to_string(f.sequence) + "  " + std::to_string(f.points) + " pts  " +
-                      std::to_string(f.objects) + " objects");
-    }));
-  }
-  bar.finish();
-
-  // Summary.
+// The summary on stdout: frames, points per frame, objects and tracks per class, points per object, time per frame.
+void printSimSummary(const std::vector<sim::SequenceReport>& reports) {
   std::vector<double> times, points, near;
   std::map<std::string, std::size_t> objects, tracks;
   std::size_t object_points = 0, total_objects = 0;
@@ -168,6 +151,33 @@ int runSim(const SimArgs& args) {
             << " ms (motion, ray casting, labels, writing); setup " << fmt(setup, 2) << " s\n";
   std::cout << "  frames/s             " << fmt(med > 0 ? 1.0 / med : 0.0, 1) << " (median), "
             << fmt(total_time > 0 ? n / total_time : 0.0, 1) << " (overall, without setup)\n";
+}
+
+int runSim(const SimArgs& args) {
+  namespace fs = std::filesystem;
+  if (!args.compare.empty()) return runCompare(args);
+  if (!args.stats.empty()) return runStats(args);
+  if (args.config.empty() || args.out.empty()) throw std::runtime_error("--config and --out are required");
+  const sim::SimOptions opt = simOptions(args);
+  if (args.sequences < 1) throw std::runtime_error("--sequences must be at least 1");
+  if (args.frames < 1 && args.replay.empty()) throw std::runtime_error("--frames must be at least 1");
+  const int sequences = args.replay.empty() ? args.sequences : 1;
+  fs::create_directories(args.out);
+
+  std::cout << "ret3d sim: " << opt.config.name << " (" << args.config << "), sensor " << opt.sensor.name << " ("
+            << opt.sensor.beams() << " beams x " << opt.sensor.columns() << " columns), " << sequences
+            << " sequence(s)" << (args.replay.empty() ? " x " + std::to_string(args.frames) + " frames" : ", replay of " + args.replay + " " + args.replay_sequence)
+            << ", seed " << args.seed << " -> " << args.out << std::endl;
+  ProgressBar bar("sim", static_cast<std::size_t>(sequences) * static_cast<std::size_t>(std::max(args.frames, 1)));
+  std::vector<sim::SequenceReport> reports;
+  for (int s = 0; s < sequences; ++s) {
+    reports.push_back(sim::simulateSequence(opt, s, [&](const sim::FrameReport& f) {
+      bar.tick(1, "seq " + std::to_string(f.sequence) + "  " + std::to_string(f.points) + " pts  " +
+                      std::to_string(f.objects) + " objects");
+    }));
+  }
+  bar.finish();
+  printSimSummary(reports);
 
   if (args.bag) {
     for (const auto& r : reports) {

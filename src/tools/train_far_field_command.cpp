@@ -1,5 +1,5 @@
 // `ret3d train far-field --near MODEL --far MODEL --near-extent=X0,X1,Y0,Y1 [--margin M] --out DIR`: the
-// two-resolution detector (issue 20, inference.far_field) as one folder of models: DIR/detector.pt is the near model
+// two-resolution detector (inference.far_field) as one folder of models: DIR/detector.pt is the near model
 // with its stored config extended by the near field (inference.grid_extent) and the far field, DIR/detector_far.pt the
 // far model. Nothing is trained: both networks keep their weights. The folder then loads as any other
 // (`--models DIR`, the nodelets' model_path) once intra_rm.pt and inter_rm.pt are beside it.

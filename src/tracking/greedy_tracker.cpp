@@ -61,19 +61,64 @@ std::vector<std::size_t> GreedyTracker::step(const std::vector<Box>& detections,
                                              const Eigen::Isometry3d& sensor_to_fixed, std::vector<Box>& out) {
   if (!std::isfinite(stamp)) throw std::invalid_argument("GreedyTracker::update: stamp is not finite");
   if (!features) feature_dim = 0;
-  if (!detections.empty() && feature_dim != feature_dim_) {  // an empty frame says nothing about its producer
-    // Histories hold one feature size: a new producer (another detector, a stage switched off) starts afresh.
-    if (!tracks_.empty()) {
-      RET3D_WARN("tracker reset: detection features changed from " << feature_dim_ << " to " << feature_dim
-                                                                    << " values; dropped " << tracks_.size()
-                                                                    << " tracks");
-      reset();
-      ++num_resets_;
-    }
-    feature_dim_ = feature_dim;
-  }
+  if (!detections.empty()) restartOnNewFeatureSize(feature_dim);
+  const double dt = advanceClock(stamp, sensor_to_fixed);
+  CandidatesByClass by_class = prepareCandidates(detections, sensor_to_fixed);
 
-  // Time since the previous frame; a jump backwards (bag loop) or a long gap makes the tracks meaningless.
+  FrameOutput frame;
+  frame.boxes.resize(detections.size());
+  frame.emitted.assign(detections.size(), 0);
+  std::vector<char> track_matched(tracks_.size(), 0);
+  std::vector<Track> born;
+  for (ObjectClass label : kDetectedClasses) {
+    std::vector<Candidate>& dets = by_class[static_cast<int>(label)];
+    std::stable_sort(dets.begin(), dets.end(),
+                     [](const Candidate& a, const Candidate& b) { return a.fixed.score > b.fixed.score; });
+    std::vector<int> det_to_track;
+    associate(label, dets, dt, stamp, det_to_track);
+    for (std::size_t k = 0; k < dets.size(); ++k) {
+      const Candidate& c = dets[k];
+      Track* track = nullptr;
+      if (det_to_track[k] >= 0) {
+        track = &tracks_[det_to_track[k]];
+        track_matched[det_to_track[k]] = 1;
+      } else {
+        if (!mayBeBorn(label, c.fixed.score)) continue;
+        born.push_back(birth(label));
+        track = &born.back();
+      }
+      updateTrack(*track, c, stamp, features ? features + c.index * feature_dim : nullptr, feature_dim);
+      if (track->confirmed) emit(*track, c, detections[c.index], sensor_to_fixed.linear(), frame);
+    }
+  }
+  ageTracks(track_matched, dt);
+  for (Track& b : born) tracks_.push_back(std::move(b));
+
+  out.clear();
+  std::vector<std::size_t> rows;
+  for (std::size_t i = 0; i < detections.size(); ++i) {
+    if (!frame.emitted[i]) continue;
+    out.push_back(frame.boxes[i]);
+    rows.push_back(i);
+  }
+  return rows;
+}
+
+// Start: histories hold one feature size, so a new producer (another detector, a stage switched off) starts afresh.
+void GreedyTracker::restartOnNewFeatureSize(std::size_t feature_dim) {
+  if (feature_dim == feature_dim_) return;
+  if (!tracks_.empty()) {
+    RET3D_WARN("tracker reset: detection features changed from " << feature_dim_ << " to " << feature_dim
+                                                                  << " values; dropped " << tracks_.size()
+                                                                  << " tracks");
+    reset();
+    ++num_resets_;
+  }
+  feature_dim_ = feature_dim;
+}
+
+// Start: the time since the previous frame; a jump backwards (bag loop) or a gap over max_time_gap drops all tracks.
+double GreedyTracker::advanceClock(double stamp, const Eigen::Isometry3d& sensor_to_fixed) {
   double dt = 0.0;
   if (has_stamp_) {
     dt = stamp - last_stamp_;
@@ -90,10 +135,13 @@ std::vector<std::size_t> GreedyTracker::step(const std::vector<Box>& detections,
   has_stamp_ = true;
   last_stamp_ = stamp;
   last_sensor_to_fixed_ = sensor_to_fixed;
+  return dt;
+}
 
-  // Detections into the fixed frame, per class, each class in descending score (CenterPoint's greedy order).
-  const Eigen::Matrix3d R = sensor_to_fixed.linear();
-  std::vector<Candidate> by_class[4];
+// Start: the valid detections of tracked classes above score_threshold, in the fixed frame, grouped by class.
+GreedyTracker::CandidatesByClass GreedyTracker::prepareCandidates(const std::vector<Box>& detections,
+                                                                  const Eigen::Isometry3d& sensor_to_fixed) {
+  CandidatesByClass by_class;
   std::size_t skipped_invalid = 0;
   for (std::size_t i = 0; i < detections.size(); ++i) {
     const Box& d = detections[i];
@@ -117,68 +165,71 @@ std::vector<std::size_t> GreedyTracker::step(const std::vector<Box>& detections,
     by_class[static_cast<int>(d.label)].push_back(std::move(c));
   }
   if (skipped_invalid > 0) RET3D_WARN("tracker: skipped " << skipped_invalid << " detections with non-finite fields");
+  return by_class;
+}
 
-  std::vector<Box> out_by_index(detections.size());
-  std::vector<char> emitted(detections.size(), 0);
-  std::vector<char> track_matched(tracks_.size(), 0);
-  std::vector<Track> born;
+// Birth and confirmation, the one place that decides them. An unmatched detection starts a tentative track when its
+// score reaches birth_score; a tentative track is confirmed (its boxes output) once a matched score reaches
+// confirm_score or it has been matched min_hits times (birth included). Tentative tracks end at their first miss
+// (ageTracks).
+bool GreedyTracker::mayBeBorn(ObjectClass label, double score) const { return score >= options_.birth_score.at(label); }
 
-  for (ObjectClass label : kDetectedClasses) {
-    std::vector<Candidate>& dets = by_class[static_cast<int>(label)];
-    std::stable_sort(dets.begin(), dets.end(),
-                     [](const Candidate& a, const Candidate& b) { return a.fixed.score > b.fixed.score; });
-    std::vector<int> det_to_track;
-    matchClass(label, dets, dt, stamp, det_to_track);
+bool GreedyTracker::confirms(const Track& track, double score) const {
+  return score >= options_.confirm_score.at(track.label) || track.hits >= options_.min_hits.at(track.label);
+}
 
-    for (std::size_t k = 0; k < dets.size(); ++k) {
-      const Candidate& c = dets[k];
-      Box fixed = c.fixed;
-      const Eigen::Vector3d centre = fixed.center();
-      Track* track = nullptr;
-      if (det_to_track[k] >= 0) {
-        track = &tracks_[det_to_track[k]];
-        track_matched[det_to_track[k]] = 1;
-      } else {
-        if (c.fixed.score < options_.birth_score.at(label)) continue;
-        born.emplace_back(static_cast<std::size_t>(options_.history_length));
-        track = &born.back();
-        track->id = next_id_++;
-        track->label = label;
-      }
-      if (c.has_velocity) {
-        track->velocity = Eigen::Vector2d(fixed.vx, fixed.vy);
-        track->velocity_known = true;
-      } else {
-        track->velocity_known = estimateVelocity(track->history, centre, stamp, track->velocity);
-        if (!track->velocity_known) track->velocity.setZero();
-        fixed.vx = track->velocity.x();
-        fixed.vy = track->velocity.y();
-      }
-      track->position = centre;
-      track->last_seen = stamp;
-      track->misses = 0;
-      if (!track->confirmed) {
-        ++track->hits;
-        track->confirmed = c.fixed.score >= options_.confirm_score.at(label) || track->hits >= options_.min_hits.at(label);
-      }
-      fixed.track_id = track->id;
-      track->history.push(fixed, stamp, features ? features + c.index * feature_dim : nullptr, feature_dim);
-      if (!track->confirmed) continue;
+// Birth: a new tentative track with the next id.
+GreedyTracker::Track GreedyTracker::birth(ObjectClass label) {
+  Track track(static_cast<std::size_t>(options_.history_length));
+  track.id = next_id_++;
+  track.label = label;
+  return track;
+}
 
-      Box out = detections[c.index];
-      out.track_id = track->id;
-      if (!c.has_velocity) {
-        const Eigen::Vector3d v = R.transpose() * Eigen::Vector3d(track->velocity.x(), track->velocity.y(), 0.0);
-        out.vx = v.x();
-        out.vy = v.y();
-      }
-      out_by_index[c.index] = out;
-      emitted[c.index] = 1;
-    }
+// Update: the track takes the detection's centre, its velocity (given, else estimated from the history), a hit
+// while tentative, and the box (with the track's velocity and id) into its history.
+void GreedyTracker::updateTrack(Track& track, const Candidate& c, double stamp, const float* feature,
+                                std::size_t feature_dim) {
+  Box fixed = c.fixed;
+  const Eigen::Vector3d centre = fixed.center();
+  if (c.has_velocity) {
+    track.velocity = Eigen::Vector2d(fixed.vx, fixed.vy);
+    track.velocity_known = true;
+  } else {
+    track.velocity_known = estimateVelocity(track.history, centre, stamp, track.velocity);
+    if (!track.velocity_known) track.velocity.setZero();
+    fixed.vx = track.velocity.x();
+    fixed.vy = track.velocity.y();
   }
+  track.position = centre;
+  track.last_seen = stamp;
+  track.misses = 0;
+  if (!track.confirmed) {
+    ++track.hits;
+    track.confirmed = confirms(track, c.fixed.score);
+  }
+  fixed.track_id = track.id;
+  track.history.push(fixed, stamp, feature, feature_dim);
+}
 
-  // Unmatched tracks coast on their velocity (not output); those unmatched for more than max_age frames end, and
-  // tentative ones at their first miss.
+// Output: the detection as given (sensor frame) with the track's id, and the track's velocity when the detection had
+// none.
+void GreedyTracker::emit(const Track& track, const Candidate& c, const Box& detection, const Eigen::Matrix3d& R,
+                         FrameOutput& frame) const {
+  Box out = detection;
+  out.track_id = track.id;
+  if (!c.has_velocity) {
+    const Eigen::Vector3d v = R.transpose() * Eigen::Vector3d(track.velocity.x(), track.velocity.y(), 0.0);
+    out.vx = v.x();
+    out.vy = v.y();
+  }
+  frame.boxes[c.index] = out;
+  frame.emitted[c.index] = 1;
+}
+
+// Age: unmatched tracks coast on their velocity (not output); those unmatched for more than max_age frames end, and
+// tentative ones at their first miss.
+void GreedyTracker::ageTracks(const std::vector<char>& track_matched, double dt) {
   std::size_t kept = 0;
   for (std::size_t t = 0; t < tracks_.size(); ++t) {
     Track& tr = tracks_[t];
@@ -190,51 +241,39 @@ std::vector<std::size_t> GreedyTracker::step(const std::vector<Box>& detections,
     ++kept;
   }
   tracks_.erase(tracks_.begin() + static_cast<std::ptrdiff_t>(kept), tracks_.end());
-  for (Track& b : born) tracks_.push_back(std::move(b));
-
-  out.clear();
-  std::vector<std::size_t> rows;
-  for (std::size_t i = 0; i < detections.size(); ++i) {
-    if (!emitted[i]) continue;
-    out.push_back(out_by_index[i]);
-    rows.push_back(i);
-  }
-  return rows;
 }
 
-void GreedyTracker::matchClass(ObjectClass label, const std::vector<Candidate>& dets, double dt, double now,
-                               std::vector<int>& det_to_track) {
+// Predict: the BEV distance between a detection and a track brought to the same instant, or infinity outside the
+// gate.
+double GreedyTracker::predictedDistance(const Candidate& c, const Track& tr, double dt, double now) const {
+  Eigen::Vector2d det_xy(c.fixed.x, c.fixed.y);
+  Eigen::Vector2d trk_xy = tr.position.head<2>();
+  double g = options_.gate.at(tr.label);
+  if (c.has_velocity) {
+    det_xy -= Eigen::Vector2d(c.fixed.vx, c.fixed.vy) * dt;  // CenterPoint: the detection moved back in time
+  } else if (tr.velocity_known) {
+    trk_xy += tr.velocity * dt;  // no detection velocity: the track moved forward instead
+  } else {
+    // Neither velocity known: the object may have moved up to max_speed since the track was last seen.
+    g += options_.max_speed.at(tr.label) * (now - tr.last_seen);
+  }
+  const double d = (det_xy - trk_xy).norm();
+  return d <= g ? d : std::numeric_limits<double>::infinity();
+}
+
+// Associate: one class's detections (descending score) to its tracks, greedily or by the optimal assignment.
+void GreedyTracker::associate(ObjectClass label, const std::vector<Candidate>& dets, double dt, double now,
+                              std::vector<int>& det_to_track) {
   det_to_track.assign(dets.size(), -1);
   std::vector<int> cls_tracks;
   for (std::size_t t = 0; t < tracks_.size(); ++t)
     if (tracks_[t].label == label) cls_tracks.push_back(static_cast<int>(t));
   if (dets.empty() || cls_tracks.empty()) return;
 
-  const double gate = options_.gate.at(label);
-  const double max_speed = options_.max_speed.at(label);
   const double kForbidden = std::numeric_limits<double>::infinity();
-  // cost(d, t): BEV distance between the detection and the track, both brought to the same instant; infinity outside
-  // the gate.
   Eigen::MatrixXd cost(dets.size(), cls_tracks.size());
-  for (std::size_t k = 0; k < dets.size(); ++k) {
-    const Candidate& c = dets[k];
-    for (std::size_t j = 0; j < cls_tracks.size(); ++j) {
-      const Track& tr = tracks_[cls_tracks[j]];
-      Eigen::Vector2d det_xy(c.fixed.x, c.fixed.y);
-      Eigen::Vector2d trk_xy = tr.position.head<2>();
-      double g = gate;
-      if (c.has_velocity) {
-        det_xy -= Eigen::Vector2d(c.fixed.vx, c.fixed.vy) * dt;  // CenterPoint: the detection moved back in time
-      } else if (tr.velocity_known) {
-        trk_xy += tr.velocity * dt;  // no detection velocity: the track moved forward instead
-      } else {
-        // Neither velocity known: the object may have moved up to max_speed since the track was last seen.
-        g += max_speed * (now - tr.last_seen);
-      }
-      const double d = (det_xy - trk_xy).norm();
-      cost(k, j) = d <= g ? d : kForbidden;
-    }
-  }
+  for (std::size_t k = 0; k < dets.size(); ++k)
+    for (std::size_t j = 0; j < cls_tracks.size(); ++j) cost(k, j) = predictedDistance(dets[k], tracks_[cls_tracks[j]], dt, now);
 
   if (options_.assignment == AssignmentMethod::Greedy) {
     std::vector<char> taken(cls_tracks.size(), 0);

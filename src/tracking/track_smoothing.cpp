@@ -107,19 +107,16 @@ void validate(const TrackSmoothingOptions& o) {
   if (!(o.frame_period > 0)) fail("frame_period must be > 0, got " + std::to_string(o.frame_period));
 }
 
-}  // namespace
-
-std::vector<std::vector<Box>> smoothTracks(const std::vector<std::vector<Box>>& frames,
-                                           const TrackSmoothingOptions& opt, TrackSmoothingStats* stats) {
-  validate(opt);
-  TrackSmoothingStats st;
+// Every track's observations in frame order, one box per track and frame (the best-scored one); boxes without a track
+// id are left out.
+std::map<std::uint32_t, std::vector<Observation>> collectTracks(const std::vector<std::vector<Box>>& frames,
+                                                                TrackSmoothingStats& st) {
   std::map<std::uint32_t, std::vector<Observation>> tracks;
   for (int f = 0; f < static_cast<int>(frames.size()); ++f) {
     for (const Box& b : frames[static_cast<std::size_t>(f)]) {
       if (b.track_id == 0) continue;
       ++st.boxes_in;
       auto& obs = tracks[b.track_id];
-      // One box per track and frame: the best-scored one.
       if (!obs.empty() && obs.back().frame == f) {
         if (b.score > obs.back().box.score) obs.back().box = b;
         continue;
@@ -128,7 +125,117 @@ std::vector<std::vector<Box>> smoothTracks(const std::vector<std::vector<Box>>& 
     }
   }
   st.tracks_in = tracks.size();
+  return tracks;
+}
 
+// The frames to label: every observed one, and the missed ones in gaps of at most max_gap frames.
+std::vector<int> targetFrames(const std::vector<Observation>& obs, int max_gap) {
+  std::vector<int> targets;
+  for (std::size_t i = 0; i < obs.size(); ++i) {
+    targets.push_back(obs[i].frame);
+    if (i + 1 < obs.size() && obs[i + 1].frame - obs[i].frame - 1 <= max_gap)
+      for (int f = obs[i].frame + 1; f < obs[i + 1].frame; ++f) targets.push_back(f);
+  }
+  return targets;
+}
+
+// One target frame's centre and velocity fit over the observations within half_window frames of it.
+struct FrameFit {
+  int frame;
+  LineFit fit;
+  std::vector<const Observation*> window;
+  const Observation* seen;  // null in a filled gap
+};
+
+// The fits of the target frames, with each fit's speed and the summed motion directions of the moving ones (to
+// orient the dominant heading).
+struct TrackMotion {
+  std::vector<FrameFit> fits;
+  std::vector<double> speeds;
+  double motion_s = 0, motion_c = 0;
+};
+
+TrackMotion fitFrames(const std::vector<Observation>& obs, const std::vector<int>& targets,
+                      const TrackSmoothingOptions& opt) {
+  TrackMotion m;
+  for (const int t : targets) {
+    FrameFit fr{t, {}, {}, nullptr};
+    const Observation* before = nullptr;
+    const Observation* after = nullptr;
+    for (const Observation& o : obs) {
+      if (std::abs(o.frame - t) <= opt.half_window) fr.window.push_back(&o);
+      if (o.frame == t) fr.seen = &o;
+      if (o.frame < t) before = &o;
+      if (o.frame > t && !after) after = &o;
+    }
+    // A gap wider than the window: interpolate between its ends.
+    if (fr.window.size() < 2 && !fr.seen && before && after) fr.window = {before, after};
+    fr.fit = robustFit(fr.window, t, opt.outlier_distance);
+    const Eigen::Vector2d v = fr.fit.velocity.head<2>() / opt.frame_period;
+    m.speeds.push_back(v.norm());
+    if (v.norm() > opt.moving_speed) m.motion_s += v.y() / v.norm(), m.motion_c += v.x() / v.norm();
+    m.fits.push_back(std::move(fr));
+  }
+  return m;
+}
+
+// The dominant heading: the axis of all observed headings (doubled-angle mean, score-weighted), pointing the way the
+// track moves when it moves, else the way most of its observations point.
+double dominantHeading(const std::vector<Observation>& obs, const std::vector<const Observation*>& all,
+                       const TrackMotion& m, bool moving) {
+  double s2 = 0, c2 = 0;
+  for (const Observation& o : obs)
+    s2 += o.box.score * std::sin(2 * o.box.yaw), c2 += o.box.score * std::cos(2 * o.box.yaw);
+  const double axis = 0.5 * std::atan2(s2, c2);
+  double vote = 0;
+  if (moving) {
+    vote = std::cos(std::atan2(m.motion_s, m.motion_c) - axis);
+  } else {
+    for (const Observation& o : obs) vote += o.box.score * (std::cos(o.box.yaw - axis) >= 0 ? 1.0 : -1.0);
+  }
+  return alignedMean(all, vote >= 0 ? axis : axis + M_PI);
+}
+
+// One kept track's smoothed boxes into `out`: a robust size and the majority class for all, per target frame the
+// fitted centre and velocity, and the heading of its motion (moving) or the dominant one.
+void smoothTrack(std::uint32_t id, const std::vector<Observation>& obs, double score, const TrackSmoothingOptions& opt,
+                 std::vector<std::vector<Box>>& out, TrackSmoothingStats& st) {
+  std::vector<const Observation*> all;
+  for (const Observation& o : obs) all.push_back(&o);
+  Box shape = obs.front().box;
+  robustSize(all, opt.size_fraction, &shape);
+  shape.label = majorityClass(obs);
+  shape.score = static_cast<float>(score);
+  shape.track_id = id;
+
+  const TrackMotion m = fitFrames(obs, targetFrames(obs, opt.max_gap), opt);
+  // Moving as a whole, by the median speed: a parked car's fit at the ends of its track can be fast by noise alone
+  // (one-sided windows), and its motion must not turn it around.
+  const bool moving = median(m.speeds) > opt.moving_speed;
+  const double dominant = dominantHeading(obs, all, m, moving);
+  for (const FrameFit& fr : m.fits) {
+    Box b = shape;
+    b.x = fr.fit.centre.x(), b.y = fr.fit.centre.y(), b.z = fr.fit.centre.z();
+    const Eigen::Vector2d v = fr.fit.velocity.head<2>() / opt.frame_period;
+    b.vx = v.x(), b.vy = v.y();
+    if (moving && v.norm() > opt.moving_speed)
+      b.yaw = alignedMean(fr.window, std::atan2(v.y(), v.x()));
+    else
+      b.yaw = moving ? alignedMean(fr.window, dominant) : dominant;
+    b.num_points = fr.seen ? fr.seen->box.num_points : 0;
+    if (!fr.seen) ++st.boxes_filled;
+    out[static_cast<std::size_t>(fr.frame)].push_back(b);
+    ++st.boxes_out;
+  }
+}
+
+}  // namespace
+
+std::vector<std::vector<Box>> smoothTracks(const std::vector<std::vector<Box>>& frames,
+                                           const TrackSmoothingOptions& opt, TrackSmoothingStats* stats) {
+  validate(opt);
+  TrackSmoothingStats st;
+  const std::map<std::uint32_t, std::vector<Observation>> tracks = collectTracks(frames, st);
   std::vector<std::vector<Box>> out(frames.size());
   for (const auto& [id, obs] : tracks) {
     double score = 0;
@@ -143,81 +250,7 @@ std::vector<std::vector<Box>> smoothTracks(const std::vector<std::vector<Box>>& 
       continue;
     }
     ++st.tracks_kept;
-    std::vector<const Observation*> all;
-    for (const Observation& o : obs) all.push_back(&o);
-    Box shape = obs.front().box;
-    robustSize(all, opt.size_fraction, &shape);
-    shape.label = majorityClass(obs);
-    shape.score = static_cast<float>(score);
-    shape.track_id = id;
-
-    // The frames to label: every observed one, and the missed ones in gaps of at most max_gap frames.
-    std::vector<int> targets;
-    for (std::size_t i = 0; i < obs.size(); ++i) {
-      targets.push_back(obs[i].frame);
-      if (i + 1 < obs.size() && obs[i + 1].frame - obs[i].frame - 1 <= opt.max_gap)
-        for (int f = obs[i].frame + 1; f < obs[i + 1].frame; ++f) targets.push_back(f);
-    }
-
-    struct Frame {
-      int frame;
-      LineFit fit;
-      std::vector<const Observation*> window;
-      const Observation* seen;  // null in a filled gap
-    };
-    std::vector<Frame> fits;
-    std::vector<double> speeds;
-    double motion_s = 0, motion_c = 0;  // summed motion directions of the moving frames, to orient the dominant heading
-    for (const int t : targets) {
-      Frame fr{t, {}, {}, nullptr};
-      const Observation* before = nullptr;
-      const Observation* after = nullptr;
-      for (const Observation& o : obs) {
-        if (std::abs(o.frame - t) <= opt.half_window) fr.window.push_back(&o);
-        if (o.frame == t) fr.seen = &o;
-        if (o.frame < t) before = &o;
-        if (o.frame > t && !after) after = &o;
-      }
-      // A gap wider than the window: interpolate between its ends.
-      if (fr.window.size() < 2 && !fr.seen && before && after) fr.window = {before, after};
-      fr.fit = robustFit(fr.window, t, opt.outlier_distance);
-      const Eigen::Vector2d v = fr.fit.velocity.head<2>() / opt.frame_period;
-      speeds.push_back(v.norm());
-      if (v.norm() > opt.moving_speed) motion_s += v.y() / v.norm(), motion_c += v.x() / v.norm();
-      fits.push_back(std::move(fr));
-    }
-
-    // The dominant heading: the axis of all observed headings (doubled-angle mean, score-weighted), pointing the way
-    // the track moves when it moves, else the way most of its observations point.
-    double s2 = 0, c2 = 0;
-    for (const Observation& o : obs)
-      s2 += o.box.score * std::sin(2 * o.box.yaw), c2 += o.box.score * std::cos(2 * o.box.yaw);
-    const double axis = 0.5 * std::atan2(s2, c2);
-    double vote = 0;
-    // Moving as a whole, by the median speed: a parked car's fit at the ends of its track can be fast by noise alone
-    // (one-sided windows), and its motion must not turn it around.
-    const bool moving = median(speeds) > opt.moving_speed;
-    if (moving) {
-      vote = std::cos(std::atan2(motion_s, motion_c) - axis);
-    } else {
-      for (const Observation& o : obs) vote += o.box.score * (std::cos(o.box.yaw - axis) >= 0 ? 1.0 : -1.0);
-    }
-    const double dominant = alignedMean(all, vote >= 0 ? axis : axis + M_PI);
-
-    for (const Frame& fr : fits) {
-      Box b = shape;
-      b.x = fr.fit.centre.x(), b.y = fr.fit.centre.y(), b.z = fr.fit.centre.z();
-      const Eigen::Vector2d v = fr.fit.velocity.head<2>() / opt.frame_period;
-      b.vx = v.x(), b.vy = v.y();
-      if (moving && v.norm() > opt.moving_speed)
-        b.yaw = alignedMean(fr.window, std::atan2(v.y(), v.x()));
-      else
-        b.yaw = moving ? alignedMean(fr.window, dominant) : dominant;
-      b.num_points = fr.seen ? fr.seen->box.num_points : 0;
-      if (!fr.seen) ++st.boxes_filled;
-      out[static_cast<std::size_t>(fr.frame)].push_back(b);
-      ++st.boxes_out;
-    }
+    smoothTrack(id, obs, score, opt, out, st);
   }
   if (stats) *stats = st;
   return out;

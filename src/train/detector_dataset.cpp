@@ -294,18 +294,14 @@ std::vector<std::size_t> epochOrder(const DetectorDataset& data, unsigned seed, 
   return order;
 }
 
-void augmentSample(DetectorSample* s, const TrainOptions& t, const BevGeometry& grid, std::mt19937* rng) {
-  std::uniform_real_distribution<double> U(0.0, 1.0);
-  if (s->has_previous && !s->prev_to_current.isApprox(Eigen::Isometry3d::Identity())) {
-    s->previous = transformCloud(s->previous, s->prev_to_current);
-    s->prev_to_current = Eigen::Isometry3d::Identity();
-  }
-  // Global rotation, flip about the x axis and scaling: one similarity applied to points and boxes.
-  const double angle = t.rotation_range > 0 ? (2 * U(*rng) - 1) * t.rotation_range : 0.0;
-  const bool flip = t.flip && U(*rng) < 0.5;
-  const double scale = t.scale_min + (t.scale_max - t.scale_min) * U(*rng);
-  const double c = std::cos(angle), sn = std::sin(angle);
-  auto moveCloud = [&](PointCloud* cloud) {
+namespace {
+
+// A rotation about z, then a flip about the x axis and a scaling: one similarity for points, boxes and wedges.
+struct Similarity {
+  double angle = 0, scale = 1, c = 1, sn = 0;
+  bool flip = false;
+
+  void moveCloud(PointCloud* cloud) const {
     for (Point& p : cloud->points) {
       const double y = flip ? -p.y : p.y;
       const double x = p.x;
@@ -313,8 +309,8 @@ void augmentSample(DetectorSample* s, const TrainOptions& t, const BevGeometry& 
       p.y = static_cast<float>(scale * (sn * x + c * y));
       p.z = static_cast<float>(scale * p.z);
     }
-  };
-  auto moveBox = [&](Box* b) {
+  }
+  void moveBox(Box* b) const {
     if (flip) b->y = -b->y, b->yaw = -b->yaw, b->vy = -b->vy;
     const double x = b->x, y = b->y, vx = b->vx, vy = b->vy;
     b->x = scale * (c * x - sn * y);
@@ -324,44 +320,72 @@ void augmentSample(DetectorSample* s, const TrainOptions& t, const BevGeometry& 
     b->vy = scale * (sn * vx + c * vy);
     b->yaw = wrapAngle(b->yaw + angle);
     b->length *= scale, b->width *= scale, b->height *= scale;
-  };
-  auto moveVector = [&](Eigen::Vector2d v) {
+  }
+  Eigen::Vector2d moveVector(Eigen::Vector2d v) const {
     if (flip) v.y() = -v.y();
     return Eigen::Vector2d(scale * (c * v.x() - sn * v.y()), scale * (sn * v.x() + c * v.y()));
-  };
-  auto moveWedge = [&](BevWedge* w) {
+  }
+  void moveWedge(BevWedge* w) const {
     w->apex = moveVector(w->apex);
     w->ray_a = moveVector(w->ray_a).normalized();
     w->ray_b = moveVector(w->ray_b).normalized();
     w->margin *= scale;
-  };
-  moveCloud(&s->current);
-  if (s->has_previous) moveCloud(&s->previous);
-  for (Box& b : s->boxes) moveBox(&b);
-  for (Box& b : s->ignore) moveBox(&b);
-  for (BevWedge& w : s->ignore_regions) moveWedge(&w);
-  if (s->labelled_view) moveWedge(&*s->labelled_view);
+  }
+  void apply(DetectorSample* s) const {
+    moveCloud(&s->current);
+    if (s->has_previous) moveCloud(&s->previous);
+    for (Box& b : s->boxes) moveBox(&b);
+    for (Box& b : s->ignore) moveBox(&b);
+    for (BevWedge& w : s->ignore_regions) moveWedge(&w);
+    if (s->labelled_view) moveWedge(&*s->labelled_view);
+  }
+};
 
-  auto filter = [&](auto inside_kept) {
-    for (PointCloud* cloud : {&s->current, &s->previous}) {
-      PointCloud kept;
-      for (const Point& p : cloud->points)
-        if (inside_kept(p.x, p.y)) kept.push_back(p);
-      *cloud = std::move(kept);
+// Global rotation (within rotation_range), flip (half of the time, when allowed) and scale (scale_min-scale_max),
+// drawn in that order.
+Similarity drawSimilarity(const TrainOptions& t, std::mt19937* rng) {
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  Similarity m;
+  m.angle = t.rotation_range > 0 ? (2 * U(*rng) - 1) * t.rotation_range : 0.0;
+  m.flip = t.flip && U(*rng) < 0.5;
+  m.scale = t.scale_min + (t.scale_max - t.scale_min) * U(*rng);
+  m.c = std::cos(m.angle), m.sn = std::sin(m.angle);
+  return m;
+}
+
+// Keeps the points of both sweeps and the boxes where inside_kept(x, y); a box left out becomes an ignored one (its
+// points are gone: neither an object nor background).
+template <class InsideKept>
+void keepInside(DetectorSample* s, InsideKept inside_kept) {
+  for (PointCloud* cloud : {&s->current, &s->previous}) {
+    PointCloud kept;
+    for (const Point& p : cloud->points)
+      if (inside_kept(p.x, p.y)) kept.push_back(p);
+    *cloud = std::move(kept);
+  }
+  std::vector<Box> boxes;
+  std::vector<bool> valid;
+  for (std::size_t i = 0; i < s->boxes.size(); ++i) {
+    if (inside_kept(s->boxes[i].x, s->boxes[i].y)) {
+      boxes.push_back(s->boxes[i]);
+      valid.push_back(s->velocity_valid[i]);
+    } else {
+      s->ignore.push_back(s->boxes[i]);
     }
-    std::vector<Box> boxes;
-    std::vector<bool> valid;
-    for (std::size_t i = 0; i < s->boxes.size(); ++i) {
-      if (inside_kept(s->boxes[i].x, s->boxes[i].y)) {
-        boxes.push_back(s->boxes[i]);
-        valid.push_back(s->velocity_valid[i]);
-      } else {
-        s->ignore.push_back(s->boxes[i]);  // its points are gone: neither an object nor background
-      }
-    }
-    s->boxes = std::move(boxes);
-    s->velocity_valid = std::move(valid);
-  };
+  }
+  s->boxes = std::move(boxes);
+  s->velocity_valid = std::move(valid);
+}
+
+}  // namespace
+
+void augmentSample(DetectorSample* s, const TrainOptions& t, const BevGeometry& grid, std::mt19937* rng) {
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  if (s->has_previous && !s->prev_to_current.isApprox(Eigen::Isometry3d::Identity())) {
+    s->previous = transformCloud(s->previous, s->prev_to_current);
+    s->prev_to_current = Eigen::Isometry3d::Identity();
+  }
+  drawSimilarity(t, rng).apply(s);
   // Random clipping: keep a random window covering 60-100 % of each side of the grid grown by 2 m on every side (a
   // 100 m square for the +-48 m grid). It once was that square whatever the grid, which cut every object beyond 50 m
   // out of 30 % of a +-80 m grid's samples.
@@ -369,7 +393,7 @@ void augmentSample(DetectorSample* s, const TrainOptions& t, const BevGeometry& 
     const double sx = grid.x_max - grid.x_min + 4, sy = grid.y_max - grid.y_min + 4;
     const double wx = sx * (0.6 + 0.4 * U(*rng)), wy = sy * (0.6 + 0.4 * U(*rng));
     const double x0 = grid.x_min - 2 + (sx - wx) * U(*rng), y0 = grid.y_min - 2 + (sy - wy) * U(*rng);
-    filter([=](double x, double y) { return x >= x0 && x < x0 + wx && y >= y0 && y < y0 + wy; });
+    keepInside(s, [=](double x, double y) { return x >= x0 && x < x0 + wx && y >= y0 && y < y0 + wy; });
   }
   // Block input: blank one to three random squares (2-8 m), as occlusions do, centred anywhere on the grid but its
   // outer 8 m.
@@ -379,7 +403,7 @@ void augmentSample(DetectorSample* s, const TrainOptions& t, const BevGeometry& 
     std::vector<std::array<double, 3>> blocks;
     for (int k = 0; k < n; ++k)
       blocks.push_back({grid.x_min + 8 + bx * U(*rng), grid.y_min + 8 + by * U(*rng), 1 + 3 * U(*rng)});
-    filter([=](double x, double y) {
+    keepInside(s, [=](double x, double y) {
       for (const auto& b : blocks)
         if (std::abs(x - b[0]) < b[2] && std::abs(y - b[1]) < b[2]) return false;
       return true;

@@ -71,6 +71,66 @@ std::vector<DetectorDataSource> dataSources(const DetectorTrainJob& job) {
   return out;
 }
 
+// The training frames: in all, and per folder its layout, label cover, frames, weight and share of an epoch.
+void logDataSources(const DetectorDataset& data, const DetectorOptions& o, double drawn) {
+  RET3D_INFO("train detector: " << data.size() << " frames, ~" << std::lround(drawn) << " drawn per epoch, head "
+                                << headTypeName(o.model.head) << ", grid " << o.model.geometry.describe());
+  for (std::size_t k = 0; k < data.sources().size(); ++k) {
+    const DetectorDataSource& src = data.sources()[k];
+    const double n = data.setSize(k) * src.weight;
+    RET3D_INFO("  " << src.root << " (" << data.layout(k) << " layout, labels cover "
+                    << labelCoverName(src.cover) << "): " << data.setSize(k) << " frames x weight " << src.weight
+                    << " = ~" << std::fixed << std::setprecision(1) << n << " per epoch, " << 100.0 * n / drawn
+                    << " % of an epoch" << std::defaultfloat);
+  }
+}
+
+// Whether ground-truth sampling runs, and from how many objects.
+void logGtSampling(const SensorAugmentOptions& o, const SensorAugmenter& augmenter) {
+  if (o.gtSamplingOn())
+    RET3D_INFO("ground-truth sampling from " << augmenter.databaseSize() << " objects of " << o.gt_database);
+  else if (!o.gt_sample_counts.empty())
+    RET3D_INFO("train.gt_sample_counts without a database (train.gt_database, --gt-database): "
+               "no ground-truth sampling");
+}
+
+// A batch's BEV images and ground truth.
+struct TrainBatch {
+  std::vector<torch::Tensor> inputs;
+  std::vector<nn::GroundTruth> gts;
+};
+
+// One sample augmented (sensor, then geometry; both from rng), encoded and added to the batch.
+void addSample(DetectorSample s, const SensorAugmenter& sensor_augment, const DetectorOptions& o,
+               const BevEncoder& encoder, std::mt19937* rng, TrainBatch* batch) {
+  const TrainOptions& t = o.train;
+  sensor_augment.apply(&s, rng);  // draws nothing while its options are off
+  augmentSample(&s, t, o.model.geometry, rng);
+  const BevImage img = encoder.encode(s.current, s.has_previous ? &s.previous : nullptr, s.prev_to_current);
+  batch->inputs.push_back(nn::bevToTensor(img));
+  nn::GroundTruth gt;
+  gt.boxes = std::move(s.boxes);
+  gt.velocity_valid = std::move(s.velocity_valid);
+  gt.ignore = std::move(s.ignore);
+  gt.ignore_regions = std::move(s.ignore_regions);
+  gt.labelled_view = s.labelled_view;
+  gt.supervised_fov_deg = t.supervised_fov_deg;
+  batch->gts.push_back(std::move(gt));
+}
+
+// One optimiser step on the batch at learning rate lr (gradients clipped to norm 10); returns the loss.
+nn::HeadLoss trainStep(nn::DetectorModel& model, torch::optim::AdamW& optim, const TrainBatch& batch, double lr,
+                       const BevGeometry& geometry, const TrainOptions& t) {
+  for (auto& group : optim.param_groups()) static_cast<torch::optim::AdamWOptions&>(group.options()).lr(lr);
+  optim.zero_grad();
+  const nn::NetworkOutput out = model.forward(torch::cat(batch.inputs));
+  nn::HeadLoss loss = model.head().loss(out, batch.gts, geometry, t);
+  loss.total.backward();
+  torch::nn::utils::clip_grad_norm_(model.net->parameters(), 10.0);
+  optim.step();
+  return loss;
+}
+
 }  // namespace
 
 DetectorTrainResult trainDetector(const DetectorTrainJob& job) {
@@ -85,24 +145,9 @@ DetectorTrainResult trainDetector(const DetectorTrainJob& job) {
   double drawn = 0;
   for (std::size_t k = 0; k < data.sources().size(); ++k) drawn += data.setSize(k) * data.sources()[k].weight;
   if (drawn <= 0) throw std::invalid_argument("train detector: every data weight is 0");
-  RET3D_INFO("train detector: " << data.size() << " frames, ~" << std::lround(drawn) << " drawn per epoch, head "
-                                << headTypeName(o.model.head) << ", grid " << o.model.geometry.describe());
-  for (std::size_t k = 0; k < data.sources().size(); ++k) {
-    const DetectorDataSource& src = data.sources()[k];
-    const double n = data.setSize(k) * src.weight;
-    RET3D_INFO("  " << src.root << " (" << data.layout(k) << " layout, labels cover "
-                    << labelCoverName(src.cover) << "): " << data.setSize(k) << " frames x weight " << src.weight
-                    << " = ~" << std::fixed << std::setprecision(1) << n << " per epoch, " << 100.0 * n / drawn
-                    << " % of an epoch" << std::defaultfloat);
-  }
-
+  logDataSources(data, o, drawn);
   const SensorAugmenter sensor_augment(t.sensor_augment);
-  if (t.sensor_augment.gtSamplingOn())
-    RET3D_INFO("ground-truth sampling from " << sensor_augment.databaseSize() << " objects of "
-                                             << t.sensor_augment.gt_database);
-  else if (!t.sensor_augment.gt_sample_counts.empty())
-    RET3D_INFO("train.gt_sample_counts without a database (train.gt_database, --gt-database): "
-               "no ground-truth sampling");
+  logGtSampling(t.sensor_augment, sensor_augment);
 
   std::shared_ptr<nn::DetectorModel> model;
   Checkpoint ck;
@@ -164,34 +209,14 @@ DetectorTrainResult trainDetector(const DetectorTrainJob& job) {
       std::mt19937 rng(t.seed * 104729u + static_cast<unsigned>(epoch) * 1009u + static_cast<unsigned>(b));
       enc_opt.geometry = multiscaleGeometry(o.model.geometry, t, &rng);
       const BevEncoder encoder(enc_opt);
-      std::vector<nn::GroundTruth> gts;
-      std::vector<torch::Tensor> inputs;
+      TrainBatch batch;
       for (int k = 0; k < t.batch_size; ++k) {
         const std::size_t pos = static_cast<std::size_t>(b) * t.batch_size + k;
         if (pos >= order.size()) break;
-        DetectorSample s = data.load(order[pos]);
-        sensor_augment.apply(&s, &rng);  // draws nothing while its options are off
-        augmentSample(&s, t, o.model.geometry, &rng);
-        const BevImage img = encoder.encode(s.current, s.has_previous ? &s.previous : nullptr, s.prev_to_current);
-        inputs.push_back(nn::bevToTensor(img));
-        nn::GroundTruth gt;
-        gt.boxes = std::move(s.boxes);
-        gt.velocity_valid = std::move(s.velocity_valid);
-        gt.ignore = std::move(s.ignore);
-        gt.ignore_regions = std::move(s.ignore_regions);
-        gt.labelled_view = s.labelled_view;
-        gt.supervised_fov_deg = t.supervised_fov_deg;
-        gts.push_back(std::move(gt));
+        addSample(data.load(order[pos]), sensor_augment, o, encoder, &rng, &batch);
       }
-      const double lr = learningRate(t, ck.step, total_steps);
-      for (auto& group : optim.param_groups())
-        static_cast<torch::optim::AdamWOptions&>(group.options()).lr(lr);
-      optim.zero_grad();
-      const nn::NetworkOutput out = model->forward(torch::cat(inputs));
-      nn::HeadLoss loss = model->head().loss(out, gts, enc_opt.geometry, t);
-      loss.total.backward();
-      torch::nn::utils::clip_grad_norm_(model->net->parameters(), 10.0);
-      optim.step();
+      const nn::HeadLoss loss =
+          trainStep(*model, optim, batch, learningRate(t, ck.step, total_steps), enc_opt.geometry, t);
       ++ck.step;
       const double lv = loss.total.item<double>();
       epoch_loss += lv;

@@ -49,6 +49,35 @@ TEST(DetectorOptions, ShippedConfigsLoadAndValidate) {
             HeadType::Anchor);
 }
 
+// The training-stage configs each start from the one before (`base:`): a variant holds only what it changes, and
+// reads as its base with those keys laid over it.
+TEST(DetectorOptions, StageConfigsReadTheirBaseChain) {
+  const std::string dir = std::string(RET3D_SOURCE_DIR) + "/config/detector/";
+  const DetectorOptions anchor = loadDetectorOptions(dir + "lwd3d_anchor.yaml");
+  const DetectorOptions robust = loadDetectorOptions(dir + "lwd3d_anchor_robust.yaml");
+  const DetectorOptions dark = loadDetectorOptions(dir + "lwd3d_anchor_dark.yaml");
+  // From lwd3d_anchor.yaml through stage 2 (IoU quality, point refinement), robust (augmentations), selftrain
+  // (thresholds) to its own keys (clear_above, object_zero_*, seed).
+  EXPECT_FALSE(anchor.model.anchor.iou_quality);
+  EXPECT_TRUE(dark.model.anchor.iou_quality);
+  EXPECT_TRUE(diffModelConfigs(dark.model, robust.model).empty());
+  EXPECT_EQ(dark.model.geometry.width(), 384);
+  EXPECT_EQ(dark.inference.point_refine.faces, std::vector<ObjectClass>{ObjectClass::Car});
+  EXPECT_FLOAT_EQ(robust.inference.score_threshold, 0.3f);
+  EXPECT_FLOAT_EQ(dark.inference.score_threshold, 0.5f);
+  EXPECT_DOUBLE_EQ(dark.train.sensor_augment.ray_drop_max, 0.3);
+  EXPECT_DOUBLE_EQ(anchor.train.sensor_augment.object_zero_probability, 0.0);
+  EXPECT_DOUBLE_EQ(dark.train.sensor_augment.object_zero_probability, 0.3);
+  EXPECT_EQ(dark.train.seed, 45u);
+  EXPECT_DOUBLE_EQ(dark.train.learning_rate, 0.0002);  // selftrain's
+  // The far field: lwd3d_anchor_long.yaml's +-80 m grid in its own 0.5 m cells.
+  const DetectorOptions far = loadDetectorOptions(dir + "lwd3d_anchor_far.yaml");
+  EXPECT_DOUBLE_EQ(far.model.geometry.resolution, 0.5);
+  EXPECT_EQ(far.model.geometry.width(), 320);
+  EXPECT_EQ(far.model.geometry.height(), 192);
+  EXPECT_EQ(far.train.epochs, 10);
+}
+
 TEST(DetectorOptions, ValuesAreReadAndDefaultsKept) {
   const auto o = detectorOptionsFromYaml(
       "model:\n  head: anchor\n  bev: {resolution: 0.5, x_min: -32, x_max: 32}\n  network: {decoder_channels: 32}\n"

@@ -17,7 +17,7 @@ namespace fs = std::filesystem;
 
 double angleDiff(double a, double b) { return std::fabs(wrapAngle(a - b)); }
 
-// Label -> box -> label must give back the geometry within 1e-4 (issue 2 acceptance); returns the largest error.
+// Label -> box -> label must give back the geometry within 1e-4; returns the largest error.
 double roundTripError(const kitti::Label& l, const kitti::Calibration& calib) {
   const Box b = kitti::labelToBox(l, calib);
   const kitti::Label r = kitti::boxToLabel(b, calib);
@@ -240,7 +240,7 @@ TEST(LabelBox, ImageBoxIsClippedAndEmptyBehindTheCamera) {
   EXPECT_LT(l.bbox[0], l.bbox[2]);
 }
 
-// Issue 23's rule: every labelled Car within 40 m of the six labelled KITTI object frames has at least
+// The rule: every labelled Car within 40 m of the six labelled KITTI object frames has at least
 // kMinCarReturns returns inside its labelled box grown by 0.25 m on each side in length and width (height unchanged).
 // The margin absorbs label offsets such as 000134's car at 34.7 m, whose visible side lies 0.15 m outside its box
 // (3 returns strictly inside). No frame or car is exempted.

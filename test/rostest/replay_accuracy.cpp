@@ -1,5 +1,5 @@
 // rostest (test/rostest/replay_accuracy.test, node `replay_accuracy`): the bag-replay harness with the default trained
-// models (issue 8). It simulates a short urban drive with the real simulator (`ret3d sim ... --bag`, a seed never used
+// models. It simulates a short urban drive with the real simulator (`ret3d sim ... --bag`, a seed never used
 // for training or selection), replays it through the real `roslaunch ret3d replay.launch` (all five nodelets in one
 // manager, rosbag play --clock with use_sim_time, the launch's default models models/lwd3d/*.pt) and checks what was
 // recorded against the simulator's bag: - an /objects message for every input cloud, drops at most 1 %; no output
@@ -52,9 +52,9 @@ constexpr double kRate = 0.25;
 // held-out set of docs/RESULTS.md, 300 frames, the same models score 58.0 / 57.7 / 70.0): the bound, about two thirds
 // of today's figure, tells a working pipeline from a broken one, not one model from another.
 constexpr double kMinMeanAp = 18.0;
-// Percent of matched ground-truth track-frames (issue 8). The pipeline's tracker (config/tracker_lwd3d_pipeline.yaml:
-// birth 0.3, pedestrian gate 0.8 m, max_age 10) gives 95.1 % on this drive with the session-4 models (95.2 % with
-// the session-3 ones, 94.9-96.2 % with the session-2 ones); the earlier birth 0.05 / gate 0.4 m measured 85.5 % (Car 91.4, Pedestrian 76.9, Cyclist
+// Percent of matched ground-truth track-frames. The pipeline's tracker (config/tracker_lwd3d_pipeline.yaml:
+// birth 0.3, pedestrian gate 0.8 m, max_age 10) gives 95.1 % on this drive with the models of that time (95.2 % and
+// 94.9-96.2 % with two earlier generations of them); the earlier birth 0.05 / gate 0.4 m measured 85.5 % (Car 91.4, Pedestrian 76.9, Cyclist
 // 95.7): one object alternating between two output tracks, pedestrians re-born outside their gate.
 constexpr double kMinIdStability = 90.0;
 // The stability figure must speak for a fair share of the ground truth: the default models match 55.0 % of the

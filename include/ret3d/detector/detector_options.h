@@ -86,7 +86,7 @@ struct GridExtent {
   BevGeometry appliedTo(BevGeometry g) const;
 };
 
-// The two-resolution detector (issue 20): a second model, trained on coarser cells over more ground (e.g. x +-80,
+// The two-resolution detector: a second model, trained on coarser cells over more ground (e.g. x +-80,
 // y +-48 m in 0.5 m cells, config/detector/lwd3d_anchor_far.yaml), runs beside this one. This model's network keeps
 // its fine cells over the near field (its grid, or inference.grid_extent); a box whose centre lies inside the near
 // field shrunk by `margin` on every side comes from it, any other box from the far model's. Each model's candidates

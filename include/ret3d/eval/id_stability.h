@@ -1,7 +1,7 @@
 // Track-id stability against ground truth: of the ground-truth track-frames that an output object covers, the share
 // whose output track id is the one that ground-truth track was covered by most often. A tracker that keeps one id
 // per object scores 100 % whatever its detection recall; every id switch, and every frame a track spends under a
-// second id, lowers it. It is the figure issue 8's replay harness asserts (>= 90 %) and a summary can print beside
+// second id, lowers it. It is the figure the bag-replay harness (test/rostest/replay_accuracy.cpp) asserts (>= 90 %) and a summary can print beside
 // MOTA, which mixes detection errors in.
 //
 // Matching, per frame and class: ground truth and output boxes of the same class are paired one to one by the optimal

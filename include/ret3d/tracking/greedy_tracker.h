@@ -9,6 +9,7 @@
 // a tentative track ends at its first miss.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -72,13 +73,42 @@ class GreedyTracker {
     explicit Track(std::size_t capacity) : history(capacity) {}
   };
   struct Candidate;  // a detection prepared for matching (fixed frame)
+  using CandidatesByClass = std::array<std::vector<Candidate>, 4>;  // indexed by ObjectClass
+  struct FrameOutput {  // the output box of each detection index, and whether it is output
+    std::vector<Box> boxes;
+    std::vector<char> emitted;
+  };
 
   // Both update()s: features is boxes.size() x feature_dim or null; returns the detection index of each output box.
+  // One frame runs the phases below in order: start, then per class predict + associate, update or birth, output;
+  // then age.
   std::vector<std::size_t> step(const std::vector<Box>& boxes, const float* features, std::size_t feature_dim,
                                 double stamp, const Eigen::Isometry3d& sensor_to_fixed, std::vector<Box>& out);
 
-  void matchClass(ObjectClass label, const std::vector<Candidate>& dets, double dt, double now,
-                  std::vector<int>& det_to_track);
+  // Start: drops all tracks when the detections' feature size changes.
+  void restartOnNewFeatureSize(std::size_t feature_dim);
+  // Start: seconds since the previous frame (0 after a reset for a backwards stamp or a gap over max_time_gap).
+  double advanceClock(double stamp, const Eigen::Isometry3d& sensor_to_fixed);
+  // Start: the trackable detections in the fixed frame, per class.
+  CandidatesByClass prepareCandidates(const std::vector<Box>& detections, const Eigen::Isometry3d& sensor_to_fixed);
+  // Predict: detection-to-track BEV distance at one instant; infinity outside the gate.
+  double predictedDistance(const Candidate& c, const Track& track, double dt, double now) const;
+  // Associate: det_to_track[k] = index into tracks_ of detection k's track, or -1.
+  void associate(ObjectClass label, const std::vector<Candidate>& dets, double dt, double now,
+                 std::vector<int>& det_to_track);
+  // Birth rule: whether an unmatched detection of this score starts a track.
+  bool mayBeBorn(ObjectClass label, double score) const;
+  // Confirmation rule: whether a tentative track, just matched with this score, is confirmed.
+  bool confirms(const Track& track, double score) const;
+  // Birth: a new tentative track.
+  Track birth(ObjectClass label);
+  // Update: a matched or newborn track takes the detection.
+  void updateTrack(Track& track, const Candidate& c, double stamp, const float* feature, std::size_t feature_dim);
+  // Output: the detection with the confirmed track's id (and velocity) into frame.
+  void emit(const Track& track, const Candidate& c, const Box& detection, const Eigen::Matrix3d& R,
+            FrameOutput& frame) const;
+  // Age: unmatched tracks coast or end.
+  void ageTracks(const std::vector<char>& track_matched, double dt);
   // Least-squares velocity over the last velocity_window centres of the history plus `current`; false if too few.
   bool estimateVelocity(const TrackHistory& history, const Eigen::Vector3d& current, double stamp,
                         Eigen::Vector2d& velocity) const;
