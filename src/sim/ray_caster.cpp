@@ -204,6 +204,38 @@ void RayCaster::slotRay(const Eigen::Isometry3d& T, int column, int beam, const 
 
 namespace {
 
+// A sweep of cols x beams slots, none hit or returned yet.
+Sweep emptySweep(int cols, int beams) {
+  Sweep sw;
+  sw.columns = cols;
+  sw.beams = beams;
+  const std::size_t n = static_cast<std::size_t>(cols) * beams;
+  sw.points.resize(n);
+  sw.time.resize(n);
+  sw.actor.assign(n, -1);
+  sw.hit.assign(n, 0);
+  sw.returned.assign(n, 0);
+  return sw;
+}
+
+// Ray k of a packet from o along d within [tnear, tfar], with no hit yet.
+void setPacketRay(RTCRayHit16* rh, int k, const Eigen::Vector3d& o, const Eigen::Vector3d& d, float tnear, float tfar) {
+  rh->ray.org_x[k] = static_cast<float>(o.x());
+  rh->ray.org_y[k] = static_cast<float>(o.y());
+  rh->ray.org_z[k] = static_cast<float>(o.z());
+  rh->ray.dir_x[k] = static_cast<float>(d.x());
+  rh->ray.dir_y[k] = static_cast<float>(d.y());
+  rh->ray.dir_z[k] = static_cast<float>(d.z());
+  rh->ray.tnear[k] = tnear;
+  rh->ray.tfar[k] = tfar;
+  rh->ray.time[k] = 0;
+  rh->ray.mask[k] = 0xffffffffu;
+  rh->ray.id[k] = static_cast<unsigned>(k);
+  rh->ray.flags[k] = 0;
+  rh->hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+  rh->hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+}
+
 // The sensor's response to a ray (from ray_org along ray_dir) that hit a surface with geometric normal ng at `range`:
 // whether a return comes back (drop-out, porous crowns, range limits, the detection floor) and its range and
 // intensity. Draws from rng in a fixed order.
@@ -254,15 +286,7 @@ Sweep RayCaster::cast(const Eigen::Isometry3d& T, std::uint64_t seed, int frame,
                       double yaw_rate) const {
   const Impl& m = *impl_;
   const int cols = sensor_.columns(), beams = sensor_.beams();
-  Sweep sw;
-  sw.columns = cols;
-  sw.beams = beams;
-  const std::size_t n = static_cast<std::size_t>(cols) * beams;
-  sw.points.resize(n);
-  sw.time.resize(n);
-  sw.actor.assign(n, -1);
-  sw.hit.assign(n, 0);
-  sw.returned.assign(n, 0);
+  Sweep sw = emptySweep(cols, beams);
   const float tnear = static_cast<float>(sensor_.min_range), tfar = static_cast<float>(sensor_.max_range);
   std::atomic<int> next_block{0};
   const int block = 32;  // columns per work item
@@ -281,20 +305,7 @@ Sweep RayCaster::cast(const Eigen::Isometry3d& T, std::uint64_t seed, int frame,
             valid[k] = b < beams && !m.ego_blocked[static_cast<std::size_t>(c) * beams + b] ? -1 : 0;
             Eigen::Vector3d o(0, 0, 0), d(1, 0, 0);
             if (b < beams) slotRay(T, c, b, ego_velocity, yaw_rate, &o, &d);
-            rh.ray.org_x[k] = static_cast<float>(o.x());
-            rh.ray.org_y[k] = static_cast<float>(o.y());
-            rh.ray.org_z[k] = static_cast<float>(o.z());
-            rh.ray.dir_x[k] = static_cast<float>(d.x());
-            rh.ray.dir_y[k] = static_cast<float>(d.y());
-            rh.ray.dir_z[k] = static_cast<float>(d.z());
-            rh.ray.tnear[k] = tnear;
-            rh.ray.tfar[k] = tfar;
-            rh.ray.time[k] = 0;
-            rh.ray.mask[k] = 0xffffffffu;
-            rh.ray.id[k] = static_cast<unsigned>(k);
-            rh.ray.flags[k] = 0;
-            rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-            rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+            setPacketRay(&rh, k, o, d, tnear, tfar);
           }
           rtcIntersect16(valid, m.top, &ctx, &rh);
           for (int k = 0; k < 16 && b0 + k < beams; ++k) {
