@@ -28,6 +28,7 @@ TEST(Detector, ReturnsBoxesWithOneFeatureRowEachAndTimesItsParts) {
   o.model.geometry.x_min = -16, o.model.geometry.x_max = 16, o.model.geometry.y_min = -16, o.model.geometry.y_max = 16;
   o.inference.score_threshold = 0.0f;  // untrained: every peak passes
   o.inference.max_detections = 20;
+  o.inference.ego_box.reset();  // the returns lie where KITTI's car would stand: every box counts here
   Detector d(o);
   PointCloud cloud;
   for (int i = 0; i < 2000; ++i) cloud.push_back({static_cast<float>(i % 40) * 0.1f, static_cast<float>(i / 40) * 0.1f, -1.0f, 0.5f});
