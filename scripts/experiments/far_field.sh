@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The two-resolution detector (docs/RESULTS.md, "Long range: a near field and a far field"): the default
+# The two-resolution detector (docs/RESULTS.md, "Long range"): the default
 # model keeps its 0.25 m cells over a near field, and a second network on 0.5 m cells over x +-80, y +-48 m gives the
 # boxes outside it (inference.far_field). The far network starts from models/lwd3d's weights
 # (config/detector/lwd3d_anchor_far.yaml), then its score calibration is refitted, both are put in one folder

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The long-range candidate (docs/RESULTS.md, "Long range at the default's cost"): the default detector's
+# The long-range candidate (docs/RESULTS.md, "Long range"): the default detector's
 # network on x +-80, y +-48 m in 1/3 m cells, started from models/lwd3d's weights, then its score calibration refitted
 # and IntraRM / InterRM trained behind it, and the validation table against the default. Resumable: every step leaves
 # a marker in OUT and a training resumes from its checkpoint.
