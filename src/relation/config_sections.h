@@ -112,9 +112,13 @@ Config readConfig(const std::string& what, const std::string& yaml_text, const s
     r.finish();
     try {
       c.model.validate();
+    } catch (const OptionError& e) {
+      r.fail("model." + e.key(), e.reason() + ", got " + e.value());
+    }
+    try {
       c.train.validate();
-    } catch (const std::invalid_argument& e) {
-      r.fail("", e.what());
+    } catch (const OptionError& e) {
+      r.fail("train." + e.key(), e.reason() + ", got " + e.value());
     }
   } catch (const ConfigError& e) {
     throw std::invalid_argument(e.what());

@@ -18,24 +18,24 @@ const std::initializer_list<std::pair<const char*, InterPositionalEncoding>> kPo
 }  // namespace
 
 void InterRMArch::validate() const {
-  auto bad = [](const std::string& m) { throw std::invalid_argument("InterRM model: " + m); };
-  if (c_enc < 4 || c_enc > 4096) bad("c_enc " + std::to_string(c_enc) + " is outside [4, 4096]");
-  if (c_enc % 4 != 0) bad("c_enc " + std::to_string(c_enc) + " must be a multiple of 4 (sinusoidal encodings)");
-  if (heads < 1 || c_enc % heads != 0)
-    bad("heads " + std::to_string(heads) + " must be >= 1 and divide c_enc " + std::to_string(c_enc));
-  if (ffn_expansion < 1 || ffn_expansion > 16) bad("ffn_expansion " + std::to_string(ffn_expansion) + " not in [1, 16]");
-  if (max_history < 1 || max_history > 10000) bad("max_history " + std::to_string(max_history) + " not in [1, 10000]");
+  checkOption("c_enc", c_enc, kCEnc);
+  if (c_enc % 4 != 0)
+    throw OptionError("c_enc", std::to_string(c_enc), "must be a multiple of 4 (sinusoidal encodings)");
+  checkOption("heads", heads, kHeads);
+  if (c_enc % heads != 0)
+    throw OptionError("heads", std::to_string(heads), "must divide c_enc " + std::to_string(c_enc));
+  checkOption("ffn_expansion", ffn_expansion, kFfnExpansion);
+  checkOption("max_history", max_history, kMaxHistory);
 }
 
 void InterRMTrainConfig::validate() const {
-  auto bad = [](const std::string& m) { throw std::invalid_argument("InterRM train: " + m); };
-  if (!(lr > 0)) bad("lr must be > 0");
-  if (!(weight_decay >= 0)) bad("weight_decay must be >= 0");
-  if (sequences_per_batch < 1) bad("sequences_per_batch must be >= 1");
-  if (epochs < 0) bad("epochs must be >= 0");
-  if (!(smooth_l1_beta > 0)) bad("smooth_l1_beta must be > 0");
-  for (ObjectClass k : kDetectedClasses)
-    if (!(reg_min_iou.at(k) > 0 && reg_min_iou.at(k) <= 1)) bad("reg_min_iou values must be in (0, 1]");
+  checkOption("lr", lr, kLr);
+  checkOption("weight_decay", weight_decay, kNonNegative);
+  checkOption("sequences_per_batch", sequences_per_batch, kSequencesPerBatch);
+  checkOption("epochs", epochs, kNonNegative);
+  checkOption("smooth_l1_beta", smooth_l1_beta, kSmoothL1Beta);
+  for (ObjectClass c : kDetectedClasses)
+    checkOption(std::string("reg_min_iou.") + className(c), reg_min_iou.at(c), kIou);
 }
 
 // The keys, in the order toYaml writes them.

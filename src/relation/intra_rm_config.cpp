@@ -1,6 +1,5 @@
 #include "ret3d/relation/intra_rm_config.h"
 
-#include <cmath>
 #include <stdexcept>
 
 #include "config_sections.h"
@@ -9,32 +8,31 @@ namespace ret3d {
 namespace relation {
 
 void IntraRMArch::validate() const {
-  if (hidden < 1) throw std::invalid_argument("IntraRM model.hidden must be >= 1, got " + std::to_string(hidden));
-  if (rounds < 1) throw std::invalid_argument("IntraRM model.rounds must be >= 1, got " + std::to_string(rounds));
-  if (head_hidden < 1) throw std::invalid_argument("IntraRM model.head_hidden must be >= 1");
-  if (!std::isfinite(radius) || radius < 0)
-    throw std::invalid_argument("IntraRM model.radius must be a finite value >= 0 (metres)");
-  if (feature_dim > 100000) throw std::invalid_argument("IntraRM model.feature_dim is implausibly large");
-  for (std::size_t k = 0; k < 3; ++k) {
-    if (!std::isfinite(score_scale[k]) || score_scale[k] <= 0)
-      throw std::invalid_argument("IntraRM model.score_scale must be finite and > 0 (a monotone calibration)");
-    if (!std::isfinite(score_bias[k])) throw std::invalid_argument("IntraRM model.score_bias must be finite");
+  checkOption("hidden", hidden, kHidden);
+  checkOption("rounds", rounds, kRounds);
+  checkOption("head_hidden", head_hidden, kHeadHidden);
+  checkOption("radius", radius, kRadius);
+  checkOption("feature_dim", static_cast<double>(feature_dim), kFeatureDim);
+  for (ObjectClass c : kDetectedClasses) {
+    checkOption(std::string("score_scale.") + className(c), score_scale.at(c), kScoreScale);
+    checkOption(std::string("score_bias.") + className(c), score_bias.at(c), kScoreBias);
   }
 }
 
 void IntraRMTrainConfig::validate() const {
-  if (!(lr > 0)) throw std::invalid_argument("IntraRM train.lr must be > 0");
-  if (weight_decay < 0) throw std::invalid_argument("IntraRM train.weight_decay must be >= 0");
-  if (frames_per_batch < 1) throw std::invalid_argument("IntraRM train.frames_per_batch must be >= 1");
-  if (epochs < 0) throw std::invalid_argument("IntraRM train.epochs must be >= 0");
-  if (loc_weight < 0 || dir_weight < 0) throw std::invalid_argument("IntraRM loss weights must be >= 0");
-  if (focal_alpha < 0 || focal_alpha > 1) throw std::invalid_argument("IntraRM train.focal_alpha must be in [0, 1]");
-  if (focal_gamma < 0) throw std::invalid_argument("IntraRM train.focal_gamma must be >= 0");
-  for (int k = 0; k < 3; ++k) {
-    if (cls_pos_iou[k] <= 0 || cls_pos_iou[k] > 1 || reg_min_iou[k] <= 0 || reg_min_iou[k] > 1)
-      throw std::invalid_argument("IntraRM IoU thresholds must be in (0, 1]");
+  checkOption("lr", lr, kLr);
+  checkOption("weight_decay", weight_decay, kNonNegative);
+  checkOption("frames_per_batch", frames_per_batch, kFramesPerBatch);
+  checkOption("epochs", epochs, kNonNegative);
+  checkOption("loc_weight", loc_weight, kNonNegative);
+  checkOption("dir_weight", dir_weight, kNonNegative);
+  checkOption("focal_alpha", focal_alpha, kFocalAlpha);
+  checkOption("focal_gamma", focal_gamma, kNonNegative);
+  for (ObjectClass c : kDetectedClasses) {
+    checkOption(std::string("cls_pos_iou.") + className(c), cls_pos_iou.at(c), kIou);
+    checkOption(std::string("reg_min_iou.") + className(c), reg_min_iou.at(c), kIou);
   }
-  if (augment_rotation < 0) throw std::invalid_argument("IntraRM train.augment_rotation must be >= 0");
+  checkOption("augment_rotation", augment_rotation, kNonNegative);
 }
 
 // The keys, in the order toYaml writes them.

@@ -8,6 +8,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "ret3d/core/yaml_reader.h"
+
 namespace ret3d {
 namespace relation {
 
@@ -37,12 +39,17 @@ bool readLearnerState(const std::string& dir, const std::string& module, int* ep
                       std::mt19937_64* rng) {
   if (!fs::exists(dir + "/state.yaml")) return false;
   try {
-    const YAML::Node s = YAML::LoadFile(dir + "/state.yaml");
-    *epoch = s["epoch"].as<int>();
-    *best_val = s["best_val"].as<double>();
-    std::istringstream r(s["rng"].as<std::string>());
+    // The one YAML reader: every key required, no other key, each of its type.
+    YamlReader s = YamlReader::load(dir + "/state.yaml");
+    std::string state;
+    if (!s.get("epoch", epoch)) s.fail("epoch", "missing");
+    if (!s.get("best_val", best_val)) s.fail("best_val", "missing");
+    if (!s.get("rng", &state)) s.fail("rng", "missing");
+    s.finish();
+    std::istringstream r(state);
     r >> *rng;
-  } catch (const YAML::Exception& e) {
+    if (!r) s.fail("rng", "not a random generator state");
+  } catch (const ConfigError& e) {
     throw std::runtime_error(module + " checkpoint " + dir + "/state.yaml: unreadable (" + std::string(e.what()) + ")");
   }
   return true;

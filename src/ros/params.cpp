@@ -87,6 +87,11 @@ std::string ParamReader::choice(const std::string& name, const std::string& fall
 }
 
 double ParamReader::number(const std::string& name, double fallback, double min, double max) const {
+  return number(name, fallback, OptionRange{min, max});
+}
+
+// One format for every range: the options structs' own words (core/option_range.h).
+double ParamReader::number(const std::string& name, double fallback, const OptionRange& range) const {
   XmlRpc::XmlRpcValue v;
   double x = fallback;
   if (nh_.getParam(name, v)) {
@@ -95,40 +100,28 @@ double ParamReader::number(const std::string& name, double fallback, double min,
     } else if (v.getType() == XmlRpc::XmlRpcValue::TypeInt) {
       x = static_cast<int>(v);
     } else {
-      throw ParamError("parameter " + fullName(name) + " = " + show(v) + ": must be a number in [" +
-                       std::to_string(min) + ", " + std::to_string(max) + "]");
+      throw ParamError("parameter " + fullName(name) + " = " + show(v) + ": must be a number; " + range.describe());
     }
   }
-  if (!(x >= min && x <= max)) {
-    std::ostringstream s;
-    s << "parameter " << fullName(name) << " = " << x << ": must be in [" << min << ", " << max << "]";
-    throw ParamError(s.str());
-  }
+  if (!range.contains(x))
+    throw ParamError("parameter " + fullName(name) + " = " + optionValueText(x) + ": " + range.describe());
   return x;
 }
 
-double ParamReader::number(const std::string& name, double fallback, const OptionRange& range) const {
-  return number(name, fallback, range.lo, range.hi);
+int ParamReader::integer(const std::string& name, int fallback, int min, int max) const {
+  return integer(name, fallback, OptionRange{static_cast<double>(min), static_cast<double>(max)});
 }
 
 int ParamReader::integer(const std::string& name, int fallback, const OptionRange& range) const {
-  return integer(name, fallback, static_cast<int>(range.lo), static_cast<int>(range.hi));
-}
-
-int ParamReader::integer(const std::string& name, int fallback, int min, int max) const {
   XmlRpc::XmlRpcValue v;
   int x = fallback;
   if (nh_.getParam(name, v)) {
-    if (v.getType() != XmlRpc::XmlRpcValue::TypeInt) {
-      throw ParamError("parameter " + fullName(name) + " = " + show(v) + ": must be an integer in [" +
-                       std::to_string(min) + ", " + std::to_string(max) + "]");
-    }
+    if (v.getType() != XmlRpc::XmlRpcValue::TypeInt)
+      throw ParamError("parameter " + fullName(name) + " = " + show(v) + ": must be an integer; " + range.describe());
     x = static_cast<int>(v);
   }
-  if (x < min || x > max) {
-    throw ParamError("parameter " + fullName(name) + " = " + std::to_string(x) + ": must be an integer in [" +
-                     std::to_string(min) + ", " + std::to_string(max) + "]");
-  }
+  if (!range.contains(x))
+    throw ParamError("parameter " + fullName(name) + " = " + std::to_string(x) + ": " + range.describe());
   return x;
 }
 
@@ -257,7 +250,8 @@ IntraRMNodeletParams loadIntraRMNodeletParams(const ros::NodeHandle& private_nh)
   const ParamReader p(private_nh);
   IntraRMNodeletParams params;
   params.intra.model_path = p.nonEmpty("model_path", defaultModelPath("intra_rm.pt"));
-  params.intra.threads = p.integer("threads", 2, 1, 64);
+  // libtorch's threads are process-wide: the detector's range.
+  params.intra.threads = p.integer("threads", 2, InferenceOptions::kThreads);
   return params;
 }
 
@@ -291,7 +285,7 @@ InterRMNodeletParams loadInterRMNodeletParams(const ros::NodeHandle& private_nh)
   params.passthrough = p.boolean("passthrough", false);
   params.publish_detections = p.boolean("publish_detections", true);
   params.inter.model_path = p.nonEmpty("model_path", defaultModelPath("inter_rm.pt"));
-  params.inter.threads = p.integer("threads", 2, 1, 64);
+  params.inter.threads = p.integer("threads", 2, InferenceOptions::kThreads);
   params.pose = loadPoseParams(p);
   if (params.passthrough) return params;  // no histories kept
   // The tracker's own options, from its tracker_config (or inline ~tracker) read as the tracker nodelet reads them:
@@ -313,11 +307,11 @@ MarkerNodeletParams loadMarkerNodeletParams(const ros::NodeHandle& private_nh) {
   const ParamReader p(private_nh);
   MarkerNodeletParams params;
   MarkerOptions& m = params.markers;
-  m.trail_length = p.integer("trail_length", m.trail_length, 0, 1000);
-  m.line_width = p.number("line_width", m.line_width, 0.001, 10.0);
-  m.text_size = p.number("text_size", m.text_size, 0.01, 100.0);
-  m.min_arrow_speed = p.number("min_arrow_speed", m.min_arrow_speed, 0.0, 1000.0);
-  m.arrow_seconds = p.number("arrow_seconds", m.arrow_seconds, 0.0, 100.0);
+  m.trail_length = p.integer("trail_length", m.trail_length, MarkerOptions::kTrailLength);
+  m.line_width = p.number("line_width", m.line_width, MarkerOptions::kLineWidth);
+  m.text_size = p.number("text_size", m.text_size, MarkerOptions::kTextSize);
+  m.min_arrow_speed = p.number("min_arrow_speed", m.min_arrow_speed, MarkerOptions::kMinArrowSpeed);
+  m.arrow_seconds = p.number("arrow_seconds", m.arrow_seconds, MarkerOptions::kArrowSeconds);
   params.pose = loadPoseParams(p);
   return params;
 }

@@ -1,23 +1,11 @@
 #include "ret3d/tracking/tracker_options.h"
 
-#include <cmath>
-#include <sstream>
 #include <stdexcept>
 
 #include "ret3d/core/yaml_reader.h"
 
 namespace ret3d {
 namespace {
-
-[[noreturn]] void invalid(const std::string& name, const std::string& value, const std::string& allowed) {
-  throw std::invalid_argument("tracker option '" + name + "' = " + value + " is invalid: allowed " + allowed);
-}
-
-std::string str(double v) {
-  std::ostringstream os;
-  os << v;
-  return os.str();
-}
 
 // A per-class option given as one number for every class or as a map by class.
 template <typename T>
@@ -51,8 +39,8 @@ TrackerOptions readTrackerOptions(YamlReader r) {
     r.finish();
     try {
       validate(o);
-    } catch (const std::invalid_argument& e) {
-      r.fail("", e.what());
+    } catch (const OptionError& e) {
+      r.fail(e.key(), e.reason() + ", got " + e.value());
     }
   } catch (const ConfigError& e) {
     throw std::invalid_argument(e.what());
@@ -65,27 +53,20 @@ TrackerOptions readTrackerOptions(YamlReader r) {
 const char* assignmentName(AssignmentMethod m) { return m == AssignmentMethod::Greedy ? "greedy" : "hungarian"; }
 
 void validate(const TrackerOptions& o) {
+  using T = TrackerOptions;
   for (ObjectClass c : kDetectedClasses) {
-    const std::string cls = className(c);
-    const double g = o.gate.at(c);
-    if (!std::isfinite(g) || g <= 0.0) invalid("gate." + cls, str(g), "a finite distance > 0 (m)");
-    const double s = o.max_speed.at(c);
-    if (!std::isfinite(s) || s < 0.0) invalid("max_speed." + cls, str(s), "a finite speed >= 0 (m/s)");
-    const double b = o.birth_score.at(c);
-    if (!std::isfinite(b)) invalid("birth_score." + cls, str(b), "a finite number");
-    const double cs = o.confirm_score.at(c);
-    if (!std::isfinite(cs)) invalid("confirm_score." + cls, str(cs), "a finite number");
-    const int h = o.min_hits.at(c);
-    if (h < 1 || h > 1000) invalid("min_hits." + cls, str(h), "an integer in [1, 1000] (frames)");
+    const std::string cls = std::string(".") + className(c);
+    checkOption("gate" + cls, o.gate.at(c), T::kGate);
+    checkOption("max_speed" + cls, o.max_speed.at(c), T::kMaxSpeed);
+    checkOption("birth_score" + cls, o.birth_score.at(c), T::kScore);
+    checkOption("confirm_score" + cls, o.confirm_score.at(c), T::kScore);
+    checkOption("min_hits" + cls, o.min_hits.at(c), T::kMinHits);
   }
-  if (!std::isfinite(o.score_threshold)) invalid("score_threshold", str(o.score_threshold), "a finite number");
-  if (o.max_age < 0 || o.max_age > 1000) invalid("max_age", str(o.max_age), "an integer in [0, 1000] (frames)");
-  if (!std::isfinite(o.max_time_gap) || o.max_time_gap <= 0.0)
-    invalid("max_time_gap", str(o.max_time_gap), "a finite time > 0 (s)");
-  if (o.velocity_window < 2 || o.velocity_window > 1000)
-    invalid("velocity_window", str(o.velocity_window), "an integer in [2, 1000] (frames)");
-  if (o.history_length < 1 || o.history_length > 100000)
-    invalid("history_length", str(o.history_length), "an integer in [1, 100000] (boxes)");
+  checkOption("score_threshold", o.score_threshold, T::kScore);
+  checkOption("max_age", o.max_age, T::kMaxAge);
+  checkOption("max_time_gap", o.max_time_gap, T::kMaxTimeGap);
+  checkOption("velocity_window", o.velocity_window, T::kVelocityWindow);
+  checkOption("history_length", o.history_length, T::kHistoryLength);
 }
 
 TrackerOptions parseTrackerOptions(const std::string& yaml_text) {

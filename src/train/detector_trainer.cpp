@@ -15,6 +15,7 @@
 #include "ret3d/bev/bev_encoder.h"
 #include "ret3d/core/log.h"
 #include "ret3d/core/progress.h"
+#include "ret3d/core/yaml_reader.h"
 #include "ret3d/detector/anchors.h"
 #include "ret3d/detector/nn/model.h"
 #include "ret3d/train/augmentations.h"
@@ -154,10 +155,12 @@ DetectorTrainResult trainDetector(const DetectorTrainJob& job) {
   const std::string base = job.out_model;
   if (job.resume && std::filesystem::exists(base + ".ckpt.state")) {
     model = nn::DetectorModel::load(base + ".ckpt", &o.model);
-    const YAML::Node st = YAML::LoadFile(base + ".ckpt.state");
-    ck.epoch = st["epoch"].as<int>();
-    ck.batch = st["batch"].as<int>();
-    ck.step = st["step"].as<int>();
+    // The one YAML reader: every key required, no other key, each an integer.
+    YamlReader st = YamlReader::load(base + ".ckpt.state");
+    for (const auto& [key, value] : {std::pair<const char*, int*>{"epoch", &ck.epoch}, {"batch", &ck.batch},
+                                      {"step", &ck.step}})
+      if (!st.get(key, value)) st.fail(key, "missing");
+    st.finish();
     RET3D_INFO("resuming from " << base << ".ckpt at epoch " << ck.epoch + 1 << ", batch " << ck.batch << ", step "
                                 << ck.step);
   } else if (!job.init_model.empty()) {

@@ -6,6 +6,8 @@
 #include <utility>
 #include <vector>
 
+#include <fstream>
+
 #include <gtest/gtest.h>
 
 #include "ret3d/relation/inter_rm.h"
@@ -106,6 +108,18 @@ TEST(RelationModelFiles, InterRMCheckpointResumesTheSameState) {
     ADD_FAILURE() << "a checkpoint of another network was loaded";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("InterRM checkpoint " + tmp.path()), std::string::npos) << e.what();
+  }
+  // A damaged state file is refused naming the file and the key.
+  for (const std::string& state : {"epoch: 1\nbest_val: 0.25\n", "epoch: one\nbest_val: 0.25\nrng: '1'\n",
+                                   "epoch: 1\nbest_val: 0.25\nrng: x\n", "[1, 2"}) {
+    std::ofstream(tmp / "state.yaml") << state;
+    InterRMLearner e(c, 3);
+    try {
+      e.loadCheckpoint(tmp.path(), &epoch, &best);
+      ADD_FAILURE() << "loaded a state file holding: " << state;
+    } catch (const std::runtime_error& err) {
+      EXPECT_NE(std::string(err.what()).find(tmp / "state.yaml"), std::string::npos) << err.what();
+    }
   }
 }
 

@@ -348,7 +348,7 @@ TEST_F(PipelineStart, InvalidTrackerOptionIsNamed) {
 
 TEST_F(PipelineStart, InvalidNumberIsNamedWithItsRange) {
   ros::param::set("/bad/tf_timeout", -1.0);
-  expectRefusal("ret3d/MarkerNodelet", {"/bad/tf_timeout", "-1", "must be in [0, 5]"});
+  expectRefusal("ret3d/MarkerNodelet", {"/bad/tf_timeout", "-1", "must lie in [0, 5]"});
 }
 
 TEST_F(PipelineStart, MissingModelFileIsNamed) {

@@ -10,11 +10,14 @@
 namespace ret3d {
 
 struct OptionRange {
+  // A bound of +-kFinite (the largest double) is no bound but finiteness: infinities are outside.
+  static constexpr double kFinite = std::numeric_limits<double>::max();
   double lo = -std::numeric_limits<double>::infinity();
   double hi = std::numeric_limits<double>::infinity();
+  bool above = false;  // true: lo itself is outside (v > lo), e.g. a distance that must be positive
 
-  bool contains(double v) const { return v >= lo && v <= hi; }  // false for NaN
-  // "must lie in [0, 1]", "must be >= 1" or "must be <= 5".
+  bool contains(double v) const { return (above ? v > lo : v >= lo) && v <= hi; }  // false for NaN
+  // "must lie in [0, 1]", "must be >= 1", "must be <= 5", "must be a finite number > 0", "must be a finite number".
   std::string describe() const;
 };
 

@@ -18,10 +18,12 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "ret3d/core/option_range.h"
 #include "ret3d/core/per_class.h"
 #include "ret3d/core/types.h"
 #include "ret3d/relation/relation_module.h"
@@ -47,7 +49,13 @@ struct InterRMArch {
   // PointRCNN boxes the learned size residuals did not carry over to held-out sequences (docs/RESULTS.md).
   bool regress_size = true;
 
-  void validate() const;  // throws std::invalid_argument naming the field
+  // Ranges (core/option_range.h), checked by validate() alone.
+  static constexpr OptionRange kCEnc{4, 4096};  // and a multiple of 4 (sinusoidal encodings)
+  static constexpr OptionRange kHeads{1, 4096};  // and a divisor of c_enc
+  static constexpr OptionRange kFfnExpansion{1, 16};
+  static constexpr OptionRange kMaxHistory{1, 10000};
+
+  void validate() const;  // throws OptionError (a std::invalid_argument) naming the field
 };
 
 struct InterRMTrainConfig {
@@ -62,7 +70,13 @@ struct InterRMTrainConfig {
   bool augment_flip = true;  // mirror y with probability 0.5
   std::uint64_t seed = 1;
 
-  void validate() const;
+  static constexpr OptionRange kLr{0, std::numeric_limits<double>::infinity(), true};
+  static constexpr OptionRange kNonNegative{0, std::numeric_limits<double>::infinity()};  // weight_decay, epochs
+  static constexpr OptionRange kSequencesPerBatch{1, std::numeric_limits<double>::infinity()};
+  static constexpr OptionRange kSmoothL1Beta{0, std::numeric_limits<double>::infinity(), true};
+  static constexpr OptionRange kIou{0, 1, true};  // reg_min_iou
+
+  void validate() const;  // throws OptionError naming the field
 };
 
 using InterRMConfig = RelationConfig<InterRMArch, InterRMTrainConfig>;

@@ -4,8 +4,10 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <string>
 
+#include "ret3d/core/option_range.h"
 #include "ret3d/core/per_class.h"
 #include "ret3d/relation/relation_module.h"
 
@@ -32,7 +34,14 @@ struct IntraRMArch {
   PerClass<double> score_scale{1.0, 1.0, 1.0};
   PerClass<double> score_bias{0.0, 0.0, 0.0};
 
-  void validate() const;  // throws std::invalid_argument naming the field
+  // Ranges (core/option_range.h), checked by validate() alone.
+  static constexpr OptionRange kHidden{1, std::numeric_limits<double>::infinity()}, kRounds{1, std::numeric_limits<double>::infinity()}, kHeadHidden{1, std::numeric_limits<double>::infinity()};
+  static constexpr OptionRange kRadius{0, OptionRange::kFinite};  // m
+  static constexpr OptionRange kFeatureDim{0, 100000};
+  static constexpr OptionRange kScoreScale{0, OptionRange::kFinite, true};  // a monotone calibration
+  static constexpr OptionRange kScoreBias{-OptionRange::kFinite, OptionRange::kFinite};
+
+  void validate() const;  // throws OptionError (a std::invalid_argument) naming the field
 };
 
 struct IntraRMTrainConfig {
@@ -53,7 +62,13 @@ struct IntraRMTrainConfig {
   double augment_rotation = 0.39;  // rotate a frame about the sensor's z axis by U(-a, a) radians
   std::uint64_t seed = 1;
 
-  void validate() const;
+  static constexpr OptionRange kLr{0, std::numeric_limits<double>::infinity(), true};
+  static constexpr OptionRange kNonNegative{0, std::numeric_limits<double>::infinity()};  // weight_decay, epochs, loss weights, focal_gamma, rotation
+  static constexpr OptionRange kFramesPerBatch{1, std::numeric_limits<double>::infinity()};
+  static constexpr OptionRange kFocalAlpha{0, 1};
+  static constexpr OptionRange kIou{0, 1, true};  // cls_pos_iou, reg_min_iou
+
+  void validate() const;  // throws OptionError naming the field
 };
 
 using IntraRMConfig = RelationConfig<IntraRMArch, IntraRMTrainConfig>;

@@ -17,6 +17,7 @@
 
 #include <Eigen/Geometry>
 
+#include "ret3d/core/option_range.h"
 #include "ret3d/core/types.h"
 
 namespace ret3d {
@@ -27,6 +28,13 @@ struct MarkerOptions {
   double text_size = 0.8;       // m, label height
   double min_arrow_speed = 0.3; // m/s: slower objects get no velocity arrow
   double arrow_seconds = 1.0;   // the arrow shows where the object is this many seconds later
+
+  // Ranges (core/option_range.h), read by the marker nodelet's parameters (ros/params.cpp).
+  static constexpr OptionRange kTrailLength{0, 1000};
+  static constexpr OptionRange kLineWidth{0.001, 10.0};
+  static constexpr OptionRange kTextSize{0.01, 100.0};
+  static constexpr OptionRange kMinArrowSpeed{0.0, 1000.0};
+  static constexpr OptionRange kArrowSeconds{0.0, 100.0};
 };
 
 // RGB in [0, 1].

@@ -5,6 +5,7 @@
 
 #include <string>
 
+#include "ret3d/core/option_range.h"
 #include "ret3d/core/per_class.h"
 #include "ret3d/core/types.h"
 
@@ -62,6 +63,17 @@ struct TrackerOptions {
   // entries are 3 s of motion, which bounds InterRM's O(N^2) attention for 50 tracks within the real-time budget.
   // To be revisited by InterRM's ablation over N (the tracker's cost hardly depends on it).
   int history_length = 30;
+
+  // The allowed range of each value (core/option_range.h), checked by validate() alone: YAML, the ROS parameters
+  // and the code that builds the struct all go through it.
+  static constexpr OptionRange kGate{0, OptionRange::kFinite, true};       // m
+  static constexpr OptionRange kMaxSpeed{0, OptionRange::kFinite};         // m/s
+  static constexpr OptionRange kScore{-OptionRange::kFinite, OptionRange::kFinite};  // score_threshold, birth, confirm
+  static constexpr OptionRange kMinHits{1, 1000};                          // frames
+  static constexpr OptionRange kMaxAge{0, 1000};                           // frames
+  static constexpr OptionRange kMaxTimeGap{0, OptionRange::kFinite, true}; // s
+  static constexpr OptionRange kVelocityWindow{2, 1000};                   // frames
+  static constexpr OptionRange kHistoryLength{1, 100000};                  // boxes
 };
 
 // Reads options from a YAML file: a map of the keys above (unknown keys are errors, so typos fail loudly); absent keys
@@ -70,7 +82,7 @@ struct TrackerOptions {
 TrackerOptions loadTrackerOptions(const std::string& yaml_path);
 // The same from YAML text.
 TrackerOptions parseTrackerOptions(const std::string& yaml_text);
-// Throws std::invalid_argument for the first invalid value.
+// Throws OptionError (a std::invalid_argument) for the first value outside its range, naming its key.
 void validate(const TrackerOptions& options);
 
 const char* assignmentName(AssignmentMethod m);
