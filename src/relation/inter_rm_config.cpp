@@ -34,8 +34,7 @@ void InterRMTrainConfig::validate() const {
   checkOption("sequences_per_batch", sequences_per_batch, kSequencesPerBatch);
   checkOption("epochs", epochs, kNonNegative);
   checkOption("smooth_l1_beta", smooth_l1_beta, kSmoothL1Beta);
-  for (ObjectClass c : kDetectedClasses)
-    checkOption(std::string("reg_min_iou.") + className(c), reg_min_iou.at(c), kIou);
+  checkOptionPerClass("reg_min_iou", reg_min_iou, kIou);
 }
 
 // The keys, in the order toYaml writes them.

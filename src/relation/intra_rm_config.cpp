@@ -13,10 +13,8 @@ void IntraRMArch::validate() const {
   checkOption("head_hidden", head_hidden, kHeadHidden);
   checkOption("radius", radius, kRadius);
   checkOption("feature_dim", static_cast<double>(feature_dim), kFeatureDim);
-  for (ObjectClass c : kDetectedClasses) {
-    checkOption(std::string("score_scale.") + className(c), score_scale.at(c), kScoreScale);
-    checkOption(std::string("score_bias.") + className(c), score_bias.at(c), kScoreBias);
-  }
+  checkOptionPerClass("score_scale", score_scale, kScoreScale);
+  checkOptionPerClass("score_bias", score_bias, kScoreBias);
 }
 
 void IntraRMTrainConfig::validate() const {
@@ -28,10 +26,8 @@ void IntraRMTrainConfig::validate() const {
   checkOption("dir_weight", dir_weight, kNonNegative);
   checkOption("focal_alpha", focal_alpha, kFocalAlpha);
   checkOption("focal_gamma", focal_gamma, kNonNegative);
-  for (ObjectClass c : kDetectedClasses) {
-    checkOption(std::string("cls_pos_iou.") + className(c), cls_pos_iou.at(c), kIou);
-    checkOption(std::string("reg_min_iou.") + className(c), reg_min_iou.at(c), kIou);
-  }
+  checkOptionPerClass("cls_pos_iou", cls_pos_iou, kIou);
+  checkOptionPerClass("reg_min_iou", reg_min_iou, kIou);
   checkOption("augment_rotation", augment_rotation, kNonNegative);
 }
 

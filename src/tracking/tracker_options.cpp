@@ -54,14 +54,11 @@ const char* assignmentName(AssignmentMethod m) { return m == AssignmentMethod::G
 
 void validate(const TrackerOptions& o) {
   using T = TrackerOptions;
-  for (ObjectClass c : kDetectedClasses) {
-    const std::string cls = std::string(".") + className(c);
-    checkOption("gate" + cls, o.gate.at(c), T::kGate);
-    checkOption("max_speed" + cls, o.max_speed.at(c), T::kMaxSpeed);
-    checkOption("birth_score" + cls, o.birth_score.at(c), T::kScore);
-    checkOption("confirm_score" + cls, o.confirm_score.at(c), T::kScore);
-    checkOption("min_hits" + cls, o.min_hits.at(c), T::kMinHits);
-  }
+  checkOptionPerClass("gate", o.gate, T::kGate);
+  checkOptionPerClass("max_speed", o.max_speed, T::kMaxSpeed);
+  checkOptionPerClass("birth_score", o.birth_score, T::kScore);
+  checkOptionPerClass("confirm_score", o.confirm_score, T::kScore);
+  checkOptionPerClass("min_hits", o.min_hits, T::kMinHits);
   checkOption("score_threshold", o.score_threshold, T::kScore);
   checkOption("max_age", o.max_age, T::kMaxAge);
   checkOption("max_time_gap", o.max_time_gap, T::kMaxTimeGap);

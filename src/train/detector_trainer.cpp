@@ -134,35 +134,26 @@ nn::HeadLoss trainStep(nn::DetectorModel& model, torch::optim::AdamW& optim, con
 
 }  // namespace
 
-DetectorTrainResult trainDetector(const DetectorTrainJob& job) {
-  const auto wall0 = std::chrono::steady_clock::now();
+namespace {
+
+// The model a run starts from: the checkpoint of an interrupted run (--resume, with its epoch, batch and step in ck),
+// the weights of job.init_model extended to the config's outputs, or fresh weights with anchors clustered from the
+// training boxes.
+std::shared_ptr<nn::DetectorModel> startingModel(const DetectorTrainJob& job, DetectorDataset& data, Checkpoint* ck) {
   const DetectorOptions& o = job.options;
   const TrainOptions& t = o.train;
-  o.model.validate();
-  torch::set_num_threads(t.threads > 0 ? t.threads : o.inference.threads);
-  torch::manual_seed(t.seed);
-
-  DetectorDataset data(dataSources(job), o.model, t.max_frames);
-  double drawn = 0;
-  for (std::size_t k = 0; k < data.sources().size(); ++k) drawn += data.setSize(k) * data.sources()[k].weight;
-  if (drawn <= 0) throw std::invalid_argument("train detector: every data weight is 0");
-  logDataSources(data, o, drawn);
-  const SensorAugmenter sensor_augment(t.sensor_augment);
-  logGtSampling(t.sensor_augment, sensor_augment);
-
+  const std::string& base = job.out_model;
   std::shared_ptr<nn::DetectorModel> model;
-  Checkpoint ck;
-  const std::string base = job.out_model;
   if (job.resume && std::filesystem::exists(base + ".ckpt.state")) {
     model = nn::DetectorModel::load(base + ".ckpt", &o.model);
     // The one YAML reader: every key required, no other key, each an integer.
     YamlReader st = YamlReader::load(base + ".ckpt.state");
-    for (const auto& [key, value] : {std::pair<const char*, int*>{"epoch", &ck.epoch}, {"batch", &ck.batch},
-                                      {"step", &ck.step}})
+    for (const auto& [key, value] : {std::pair<const char*, int*>{"epoch", &ck->epoch}, {"batch", &ck->batch},
+                                      {"step", &ck->step}})
       if (!st.get(key, value)) st.fail(key, "missing");
     st.finish();
-    RET3D_INFO("resuming from " << base << ".ckpt at epoch " << ck.epoch + 1 << ", batch " << ck.batch << ", step "
-                                << ck.step);
+    RET3D_INFO("resuming from " << base << ".ckpt at epoch " << ck->epoch + 1 << ", batch " << ck->batch << ", step "
+                                << ck->step);
   } else if (!job.init_model.empty()) {
     if (job.resume)
       RET3D_INFO("--resume: no checkpoint at " << base << ".ckpt.state yet; starting from " << job.init_model);
@@ -183,6 +174,30 @@ DetectorTrainResult trainDetector(const DetectorTrainJob& job) {
     }
     model = std::make_shared<nn::DetectorModel>(o.model, anchors);
   }
+  return model;
+}
+
+}  // namespace
+
+DetectorTrainResult trainDetector(const DetectorTrainJob& job) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  const DetectorOptions& o = job.options;
+  const TrainOptions& t = o.train;
+  o.model.validate();
+  torch::set_num_threads(t.threads > 0 ? t.threads : o.inference.threads);
+  torch::manual_seed(t.seed);
+
+  DetectorDataset data(dataSources(job), o.model, t.max_frames);
+  double drawn = 0;
+  for (std::size_t k = 0; k < data.sources().size(); ++k) drawn += data.setSize(k) * data.sources()[k].weight;
+  if (drawn <= 0) throw std::invalid_argument("train detector: every data weight is 0");
+  logDataSources(data, o, drawn);
+  const SensorAugmenter sensor_augment(t.sensor_augment);
+  logGtSampling(t.sensor_augment, sensor_augment);
+
+  Checkpoint ck;
+  const std::string base = job.out_model;
+  std::shared_ptr<nn::DetectorModel> model = startingModel(job, data, &ck);
   model->net->train();
   torch::optim::AdamW optim(model->net->parameters(),
                             torch::optim::AdamWOptions(t.learning_rate).weight_decay(t.weight_decay));

@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "ret3d/core/types.h"
+
 namespace ret3d {
 
 struct OptionRange {
@@ -42,5 +44,11 @@ std::string optionValueText(double v);
 
 // Throws OptionError(key, v, range.describe()) unless range.contains(v).
 void checkOption(const std::string& key, double v, const OptionRange& range);
+
+// checkOption for a per-class value of each detected class, keyed "key.Car", "key.Pedestrian", ...
+template <class PerClassValues>
+void checkOptionPerClass(const std::string& key, const PerClassValues& values, const OptionRange& range) {
+  for (ObjectClass c : kDetectedClasses) checkOption(key + "." + className(c), values.at(c), range);
+}
 
 }  // namespace ret3d
