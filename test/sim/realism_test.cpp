@@ -3,9 +3,7 @@
 
 #include <cmath>
 #include <algorithm>
-#include <fstream>
 #include <map>
-#include <sstream>
 
 #include <gtest/gtest.h>
 
@@ -14,6 +12,7 @@
 #include "ret3d/sim/ray_caster.h"
 #include "ret3d/sim/scene.h"
 #include "ret3d/sim/simulator.h"
+#include "support/sim_info.h"
 #include "support/test_util.h"
 
 namespace ret3d {
@@ -270,21 +269,8 @@ TEST(Realism, MountJitterKeepsBoxesOnTheirPoints) {
   o.config.mount_tilt_jitter_deg = 2.0;
   simulateSequence(o, 0);
   kitti::TrackingDataset ds(out.path()), ds0(plain.path());
-  // frame track class x y z l w h yaw vx vy num_points ... (sim_info, docs/SIMULATOR.md)
   std::vector<std::pair<int, Box>> info;
-  std::ifstream f(out / "training/sim_info/0000.txt");
-  std::string line;
-  while (std::getline(f, line)) {
-    if (line.empty() || line[0] == '#') continue;
-    std::istringstream s(line);
-    int frame = 0, track = 0;
-    std::string cls;
-    Box b;
-    s >> frame >> track >> cls >> b.x >> b.y >> b.z >> b.length >> b.width >> b.height >> b.yaw >> b.vx >> b.vy >>
-        b.num_points;
-    ASSERT_FALSE(s.fail()) << line;
-    info.emplace_back(frame, b);
-  }
+  for (const test::SimInfoRow& r : test::readSimInfo(out / "training/sim_info/0000.txt")) info.emplace_back(r.frame, r.box);
   std::size_t checked = 0;
   for (int fr = 0; fr < 2; ++fr) {
     const PointCloud cloud = kitti::readVelodyne(ds.velodynePath("0000", fr));

@@ -2,9 +2,7 @@
 // (docs/SIMULATOR.md "Paints and the detection floor", "Queues", "Roadside structures").
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <map>
-#include <sstream>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -13,6 +11,7 @@
 #include "ret3d/sim/ray_caster.h"
 #include "ret3d/sim/scene.h"
 #include "ret3d/sim/simulator.h"
+#include "support/sim_info.h"
 #include "support/test_util.h"
 
 namespace ret3d {
@@ -113,29 +112,6 @@ TEST(Paint, CarColoursIncludeAQuarterDark) {
   EXPECT_NEAR(bright / static_cast<double>(n), 0.28, 0.03);
 }
 
-struct Row {
-  int frame = 0;
-  std::string type;
-  double x = 0, y = 0, length = 0, width = 0, height = 0, yaw = 0;
-};
-
-std::vector<Row> readSimInfo(const std::string& path) {
-  std::vector<Row> rows;
-  std::ifstream f(path);
-  std::string line;
-  while (std::getline(f, line)) {
-    if (line.empty() || line[0] == '#') continue;
-    std::istringstream s(line);
-    Row r;
-    int track = 0;
-    double z = 0;
-    s >> r.frame >> track >> r.type >> r.x >> r.y >> z >> r.length >> r.width >> r.height >> r.yaw;
-    EXPECT_FALSE(s.fail()) << line;
-    rows.push_back(r);
-  }
-  return rows;
-}
-
 TEST(Queue, ALabelledCarStandsThreeToEightMetresAheadInMostFrames) {
   test::TempDir out;
   SimOptions o;
@@ -152,13 +128,11 @@ TEST(Queue, ALabelledCarStandsThreeToEightMetresAheadInMostFrames) {
     o.seed = seed;
     simulateSequence(o, 0);
     std::vector<bool> ahead(o.frames, false);
-    for (const Row& r : readSimInfo(out / "training/sim_info/0000.txt")) {
+    for (const test::SimInfoRow& r : test::readSimInfo(out / "training/sim_info/0000.txt")) {
       ++types[r.type];
-      if (r.type == "Truck") EXPECT_GT(r.length, 5.5);
-      if (r.type == "Car") EXPECT_LE(r.length, 5.2);
-      // In the ego's lane, heading its way, its rear 3-8 m from the sensor.
-      const double rear = r.x - 0.5 * r.length * std::abs(std::cos(r.yaw));
-      if (r.type == "Car" && std::abs(r.y) < 1.2 && std::cos(r.yaw) > 0.9 && rear > 3 && rear < 8) ahead[r.frame] = true;
+      if (r.type == "Truck") { EXPECT_GT(r.box.length, 5.5); }
+      if (r.type == "Car") { EXPECT_LE(r.box.length, 5.2); }
+      if (test::isCarAhead(r)) ahead[r.frame] = true;
     }
     ahead_frames += static_cast<int>(std::count(ahead.begin(), ahead.end(), true));
     frames += o.frames;

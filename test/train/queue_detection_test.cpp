@@ -3,8 +3,6 @@
 // 3-8 m ahead in the ego's lane, seen from behind, is published in every frame (a Car box at the model's published
 // threshold, its centre within 1 m of the car's). For a vehicle it is the most important object of the scene.
 #include <cmath>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -15,6 +13,7 @@
 #include "ret3d/io/kitti.h"
 #include "ret3d/io/sweeps.h"
 #include "ret3d/sim/simulator.h"
+#include "support/sim_info.h"
 #include "support/test_util.h"
 
 namespace ret3d {
@@ -25,23 +24,11 @@ struct Ahead {
   double x = 0, y = 0;
 };
 
-// Per frame, the labelled car in the ego's lane heading its way with its rear 3-8 m ahead of the sensor
-// (sim_info: frame, track, type, x, y, z, length, width, height, yaw in the sensor frame).
+// Per frame, the labelled car ahead in the ego's lane (test::isCarAhead).
 std::vector<Ahead> carsAhead(const std::string& sim_info, int frames) {
   std::vector<Ahead> ahead(static_cast<std::size_t>(frames));
-  std::ifstream f(sim_info);
-  std::string line;
-  while (std::getline(f, line)) {
-    if (line.empty() || line[0] == '#') continue;
-    std::istringstream s(line);
-    int frame = 0, track = 0;
-    std::string type;
-    double x = 0, y = 0, z = 0, l = 0, w = 0, h = 0, yaw = 0;
-    s >> frame >> track >> type >> x >> y >> z >> l >> w >> h >> yaw;
-    const double rear = x - 0.5 * l * std::abs(std::cos(yaw));
-    if (type == "Car" && std::abs(y) < 1.2 && std::cos(yaw) > 0.9 && rear > 3 && rear < 8 && frame < frames)
-      ahead[static_cast<std::size_t>(frame)] = {true, x, y};
-  }
+  for (const test::SimInfoRow& r : test::readSimInfo(sim_info))
+    if (test::isCarAhead(r) && r.frame < frames) ahead[static_cast<std::size_t>(r.frame)] = {true, r.box.x, r.box.y};
   return ahead;
 }
 
