@@ -10,13 +10,14 @@ namespace sim {
 
 std::map<std::string, MaterialConfig> defaultMaterials() {
   // Reflectivities chosen so the intensity histogram resembles KITTI's HDL-64E (docs/SIMULATOR.md): the road near 0.3,
-  // bright paint and retro-reflective signs and plates, glass and foliage that often return nothing.
+  // bright paint and retro-reflective signs and plates, glass and foliage that often return nothing; a car's windows
+  // return weakly from the cabin behind them.
   return {
       {"asphalt", {0.28, 0.05, 0.0}},   {"marking", {0.60, 0.08, 0.0}},  {"concrete", {0.28, 0.04, 0.0}},
       {"curb", {0.30, 0.04, 0.0}},      {"terrain", {0.22, 0.06, 0.02}}, {"building", {0.25, 0.08, 0.0}},
       {"glass", {0.06, 0.03, 0.5}},     {"foliage", {0.20, 0.06, 0.35}}, {"bark", {0.25, 0.05, 0.0}},
       {"metal", {0.35, 0.08, 0.0}},     {"sign", {0.95, 0.04, 0.0}},     {"paint", {0.35, 0.15, 0.0}},
-      {"car_glass", {0.05, 0.02, 0.6}}, {"tire", {0.05, 0.02, 0.05}},    {"plate", {0.95, 0.03, 0.0}},
+      {"car_glass", {0.07, 0.02, 0.0}}, {"tire", {0.05, 0.02, 0.05}},    {"plate", {0.95, 0.03, 0.0}},
       {"skin", {0.35, 0.05, 0.0}},      {"clothing", {0.25, 0.10, 0.0}},
   };
 }
