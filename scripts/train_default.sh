@@ -197,7 +197,8 @@ calibrate() {
 # Dark cars: two more epochs on data made by the simulator with car paints of every colour and a detection floor,
 # stop-and-go queues and real roadside structures (data/sim6_*), plus the three labelled KITTI frames of
 # training_extra (camera view), some cars darkened further (config/detector/lwd3d_anchor_dark.yaml); then the score
-# calibration refitted on that simulator's relation set, every class on "3D IoU >= 0.5 with a labelled object" (the
+# calibration refitted on the relation set of today's simulator, whose car windows return from the cabin as real ones
+# do (data/sim8_relation_urban), every class on "3D IoU >= 0.5 with a labelled object" (the
 # published score: how likely the box is a real object of its class), stored in the model with `ret3d train set-config`.
 SIM6_TRAIN=(--data data/sim6_train_urban data/sim6_train_highway data/sim6_train_queue
   "$DATA_DIR/kitti_object/training_extra" --data-weights 1 1 1 40 --labels-cover all all all camera
@@ -206,7 +207,7 @@ dark_round() {  # init-model
   simulate sim6_train_urban config/sim/urban_street.yaml 32 80 1000
   simulate sim6_train_highway config/sim/highway.yaml 8 60 2000
   simulate sim6_train_queue config/sim/queue.yaml 8 80 2500
-  simulate sim6_relation_urban config/sim/urban_street.yaml 12 80 3000
+  simulate sim8_relation_urban config/sim/urban_street.yaml 12 80 3000
   [ -f data/gtdb/sim6_train.gtdb ] || ret3d train gtdb --data data/sim6_train_urban data/sim6_train_highway \
     data/sim6_train_queue --config config/detector/lwd3d_anchor_robust.yaml --out data/gtdb/sim6_train.gtdb \
     >"$OUT/gtdb6.log" 2>&1
@@ -215,7 +216,7 @@ dark_round() {  # init-model
       --out "$OUT/dark.pt" --threads 2 --resume >"$OUT/train_dark.log" 2>&1
     touch "$OUT/dark.done"
   fi
-  local nocal=$OUT/dark_nocal.yaml cal=$OUT/dark_calibrated.yaml pred=$OUT/calib6_pred rel=data/sim6_relation_urban
+  local nocal=$OUT/dark_nocal.yaml cal=$OUT/dark_calibrated.yaml pred=$OUT/calib6_pred rel=data/sim8_relation_urban
   if [ ! -f "$OUT/dark_calibrated.done" ]; then
     python3 scripts/calibration_config.py strip config/detector/lwd3d_anchor_dark.yaml "$nocal"
     ret3d train set-config --model "$OUT/dark.pt" --config "$nocal" --out "$OUT/dark_nocal.pt" >/dev/null

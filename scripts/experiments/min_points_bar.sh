@@ -16,7 +16,7 @@ set -u
 export OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-PASSIVE}
 # shellcheck source=../simulate_once.sh
 source scripts/simulate_once.sh
-VAL=data/sim6_val_urban
+VAL=data/sim8_val_urban
 OUT=out/min_points/$NAME
 mkdir -p "$OUT"
 simulate_once "$VAL" config/sim/urban_street.yaml 2 50 5000 "$OUT/sim.log"
