@@ -216,20 +216,22 @@ dark_round() {  # init-model
       --out "$OUT/dark.pt" --threads 2 --resume >"$OUT/train_dark.log" 2>&1
     touch "$OUT/dark.done"
   fi
-  local nocal=$OUT/dark_nocal.yaml cal=$OUT/dark_calibrated.yaml pred=$OUT/calib6_pred rel=data/sim8_relation_urban
-  if [ ! -f "$OUT/dark_calibrated.done" ]; then
+  local nocal=$OUT/dark_nocal.yaml cal=$OUT/dark_calibrated.yaml pred=$OUT/calib8_pred
+  local rel=data/sim8_relation_urban
+  # Named after the relation set, so that a run resumed from a calibration on an older simulator fits again.
+  if [ ! -f "$OUT/dark_calibrated8.done" ]; then
     python3 scripts/calibration_config.py strip config/detector/lwd3d_anchor_dark.yaml "$nocal"
     ret3d train set-config --model "$OUT/dark.pt" --config "$nocal" --out "$OUT/dark_nocal.pt" >/dev/null
     ret3d detect --data $rel --detector-model "$OUT/dark_nocal.pt" --stages base --score-threshold 0.3 \
-      --out "$pred" >"$OUT/calib6_detect.log" 2>&1
+      --out "$pred" >"$OUT/calib8_detect.log" 2>&1
     for c in Car Pedestrian Cyclist; do
       local shape=(); [ $c = Car ] || shape=(--no-shape)
       python3 scripts/fit_score_calibration.py --gt $rel --pred "$pred" --class $c --iou 0.5 "${shape[@]}" \
-        >"$OUT/calib6_$c.log"
+        >"$OUT/calib8_$c.log"
     done
-    python3 scripts/calibration_config.py insert "$nocal" "$cal" "$OUT"/calib6_{Car,Pedestrian,Cyclist}.log
+    python3 scripts/calibration_config.py insert "$nocal" "$cal" "$OUT"/calib8_{Car,Pedestrian,Cyclist}.log
     ret3d train set-config --model "$OUT/dark.pt" --config "$cal" --out "$OUT/dark_calibrated.pt"
-    touch "$OUT/dark_calibrated.done"
+    touch "$OUT/dark_calibrated8.done"
   fi
   model="$OUT/dark_calibrated.pt"
 }

@@ -270,7 +270,9 @@ TEST(Realism, MountJitterKeepsBoxesOnTheirPoints) {
   simulateSequence(o, 0);
   kitti::TrackingDataset ds(out.path()), ds0(plain.path());
   std::vector<std::pair<int, Box>> info;
-  for (const test::SimInfoRow& r : test::readSimInfo(out / "training/sim_info/0000.txt")) info.emplace_back(r.frame, r.box);
+  for (const test::SimInfoRow& r : test::readSimInfo(out / "training/sim_info/0000.txt")) {
+    info.emplace_back(r.frame, r.box);
+  }
   std::size_t checked = 0;
   for (int fr = 0; fr < 2; ++fr) {
     const PointCloud cloud = kitti::readVelodyne(ds.velodynePath("0000", fr));

@@ -33,8 +33,8 @@ inline std::vector<SimInfoRow> readSimInfo(const std::string& path) {
     std::istringstream s(line);
     SimInfoRow r;
     Box& b = r.box;
-    s >> r.frame >> r.track >> r.type >> b.x >> b.y >> b.z >> b.length >> b.width >> b.height >> b.yaw >> b.vx >> b.vy >>
-        b.num_points;
+    s >> r.frame >> r.track >> r.type >> b.x >> b.y >> b.z >> b.length >> b.width >> b.height >> b.yaw >> b.vx >>
+        b.vy >> b.num_points;
     EXPECT_FALSE(s.fail()) << line;
     rows.push_back(r);
   }
