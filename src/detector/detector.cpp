@@ -158,11 +158,13 @@ void refineBoxes(const PointCloud& cloud, const InferenceOptions& o, std::vector
   headingFromVelocity(boxes, o.heading_from_velocity);
 }
 
-// Calibrated classes were let in below score_threshold (candidate_threshold): their final scores decide. Nothing
-// stands inside or against the vehicle's own body (ego, when set).
-void dropLowOrOnEgo(float min_score, const EgoBox* ego, const Eigen::Isometry3d& sensor_to_base, std::vector<Box>* boxes) {
+// Calibrated classes were let in below their score thresholds (candidate_threshold): their final scores decide.
+// Nothing stands inside or against the vehicle's own body (ego, when set).
+void dropLowOrOnEgo(const InferenceOptions& o, const EgoBox* ego, const Eigen::Isometry3d& sensor_to_base,
+                    std::vector<Box>* boxes) {
   auto low = [&](const Box& b) {
-    return b.score < min_score || (ego && ego->touches(b, sensor_to_base, InferenceOptions::kEgoMargin));
+    return b.score < o.scoreThreshold(b.label) ||
+           (ego && ego->touches(b, sensor_to_base, InferenceOptions::kEgoMargin));
   };
   boxes->erase(std::remove_if(boxes->begin(), boxes->end(), low), boxes->end());
 }
@@ -271,8 +273,8 @@ Detections Detector::detect(const PointCloud& current_in, const PointCloud* prev
   // Each box refined and scored by its own model's options.
   refineBoxes(current, o, &det.boxes);
   if (!far_boxes.empty()) refineBoxes(current, im.far_inference, &far_boxes);
-  dropLowOrOnEgo(o.score_threshold, ego ? &*ego : nullptr, im.sensor_to_base, &det.boxes);
-  dropLowOrOnEgo(o.score_threshold, ego ? &*ego : nullptr, im.sensor_to_base, &far_boxes);
+  dropLowOrOnEgo(o, ego ? &*ego : nullptr, im.sensor_to_base, &det.boxes);
+  dropLowOrOnEgo(o, ego ? &*ego : nullptr, im.sensor_to_base, &far_boxes);
   timings_.refine_ms = msSince(t0);
 
   // The features o_i belong to decoding (Ret3D §3.1): timed with it. Each box's from its own model's map; the boxes
@@ -296,7 +298,7 @@ const Eigen::Isometry3d& Detector::sensorToBase() const { return impl_->sensor_t
 
 void Detector::setThresholds(double score_threshold, double nms_iou) {
   InferenceOptions next = options_.inference;
-  next.score_threshold = static_cast<float>(score_threshold);
+  next.setScoreThreshold(static_cast<float>(score_threshold));
   next.nms_iou = nms_iou;
   next.validate();
   options_.inference = next;

@@ -92,6 +92,8 @@ BevGeometry DetectorOptions::inferenceGeometry() const {
 void InferenceOptions::validate() const {
   checkOption("threads", threads, kThreads);
   checkOption("score_threshold", score_threshold, kScoreThreshold);
+  for (const auto& [c, t] : class_score_threshold)
+    checkOption(std::string("class_score_threshold.") + className(c), t, kScoreThreshold);
   checkOption("candidate_threshold", candidate_threshold, kCandidateThreshold);
   checkOption("max_candidates", max_candidates, kMaxCandidates);
   checkOption("max_detections", max_detections, kMaxDetections);
@@ -156,10 +158,29 @@ void TrainOptions::validate() const {
   sensor_augment.validate();
 }
 
+float InferenceOptions::scoreThreshold(ObjectClass c) const {
+  for (const auto& [k, t] : class_score_threshold)
+    if (k == c) return static_cast<float>(t);
+  return score_threshold;
+}
+
+void InferenceOptions::setScoreThreshold(float t) {
+  score_threshold = t;
+  class_score_threshold.clear();
+}
+
+std::string InferenceOptions::describeScoreThresholds() const {
+  std::string s = optionValueText(score_threshold);
+  for (std::size_t i = 0; i < class_score_threshold.size(); ++i)
+    s += std::string(i ? ", " : " (") + className(class_score_threshold[i].first) + " " +
+         optionValueText(class_score_threshold[i].second) + (i + 1 == class_score_threshold.size() ? ")" : "");
+  return s;
+}
+
 float InferenceOptions::candidateThreshold(ObjectClass c) const {
   for (const auto& [calibrated, weights] : point_refine.score_calibration)
-    if (calibrated == c) return std::min(candidate_threshold, score_threshold);
-  return score_threshold;
+    if (calibrated == c) return std::min(candidate_threshold, scoreThreshold(c));
+  return scoreThreshold(c);
 }
 
 void DetectorOptions::validate() const {
@@ -249,6 +270,7 @@ void readInference(YamlReader r, InferenceOptions* o) {
   r.get("model_path", &o->model_path);
   r.get("threads", &o->threads);
   r.get("score_threshold", &o->score_threshold);
+  readClassValues(r, "class_score_threshold", &o->class_score_threshold);
   r.get("candidate_threshold", &o->candidate_threshold);
   r.get("max_candidates", &o->max_candidates);
   r.get("max_detections", &o->max_detections);

@@ -88,9 +88,10 @@ OfflinePipeline::OfflinePipeline(const PipelineConfig& c) : stages_(c.stages) {
     o.inference.threads = c.threads;
     // As the nodelets feed their tracker: pipeline/score_threshold.h says which source wins.
     const bool tracks = has(stages_, "track") || has(stages_, "inter");
-    o.inference.score_threshold =
-        chooseScoreThreshold(o.inference.score_threshold, c.params_score_threshold, tracks,
-                             c.score_threshold >= 0 ? std::optional<double>(c.score_threshold) : std::nullopt);
+    if (const std::optional<float> t =
+            chooseScoreThreshold(c.params_score_threshold, tracks,
+                                 c.score_threshold >= 0 ? std::optional<double>(c.score_threshold) : std::nullopt))
+      o.inference.setScoreThreshold(*t);
     try {
       if (!c.grid_extent.empty()) o.inference.grid_extent = GridExtent::fromValues(c.grid_extent);
       o.validate();
@@ -106,7 +107,7 @@ OfflinePipeline::OfflinePipeline(const PipelineConfig& c) : stages_(c.stages) {
     }
     detector_ = std::make_unique<Detector>(o);
     desc << "; detector " << path << " (" << headTypeName(o.model.head) << " head, " << detector_->parameterCount()
-         << " parameters, score >= " << o.inference.score_threshold << ", grid " << detector_->describeGrids() << ")";
+         << " parameters, score >= " << o.inference.describeScoreThresholds() << ", grid " << detector_->describeGrids() << ")";
   }
   if (has(stages_, "intra")) {
     const std::string path =

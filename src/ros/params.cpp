@@ -202,8 +202,8 @@ DetectorNodeletParams loadDetectorNodeletParams(const ros::NodeHandle& private_n
   const std::optional<double> score_threshold =
       p.has("score_threshold") ? std::optional<double>(p.number("score_threshold", 0, I::kScoreThreshold))
                                : std::nullopt;
-  inf.score_threshold =
-      pipeline::chooseScoreThreshold(inf.score_threshold, score_threshold, /*tracks=*/true, std::nullopt);
+  if (const std::optional<float> t = pipeline::chooseScoreThreshold(score_threshold, /*tracks=*/true, std::nullopt))
+    inf.setScoreThreshold(*t);
   inf.candidate_threshold =
       static_cast<float>(p.number("candidate_threshold", inf.candidate_threshold, I::kCandidateThreshold));
   inf.nms_iou = p.number("nms_iou", inf.nms_iou, I::kNmsIou);

@@ -140,7 +140,7 @@ DrawnDetections runDetector(DrawArgs& a, const PointCloud& cloud, BevView* view)
                                                               : a.pipeline.detector_model;
   const fs::path m(model);  // its folder and name say which model it is (models/lwd3d/detector.pt -> lwd3d/...)
   d.source = "LWD-3D " + (m.parent_path().filename() / m.filename()).string() + ", score >= " +
-             fixed(p.detector()->options().inference.score_threshold, 2);
+             p.detector()->options().inference.describeScoreThresholds();
   return d;
 }
 

@@ -74,7 +74,7 @@ io::SequenceDetections DetectorSource::run(const std::string& data, const std::s
                                            const std::string& default_cache, const std::string& suffix) const {
   DetectorOptions det = detectorOptionsForModel(model);
   det.inference.threads = threads;
-  if (score_threshold >= 0) det.inference.score_threshold = score_threshold;
+  if (score_threshold >= 0) det.inference.setScoreThreshold(static_cast<float>(score_threshold));
   const std::vector<std::string> seqs =
       sequences.empty() ? std::vector<std::string>{} : eval::parseSequenceList(sequences);
   return train::detectSequences(data, seqs, det, (cache.empty() ? default_cache : cache) + suffix);

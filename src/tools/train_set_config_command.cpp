@@ -33,7 +33,7 @@ CommandRun setup(CLI::App& app) {
     writeModelFile(*out, file.metadata, file.weights);
     const Detector detector(detectorOptionsForModel(*out));  // loads as the pipeline will
     std::cout << *out << ": " << *config << " stored; published from score "
-              << detector.options().inference.score_threshold << std::endl;
+              << detector.options().inference.describeScoreThresholds() << std::endl;
     return 0;
   };
 }

@@ -23,7 +23,7 @@ io::SequenceDetections detectSequences(const std::string& data_dir, const std::v
   if (fs::exists(model))
     key += " " + std::to_string(fs::file_size(model)) + " " +
            std::to_string(fs::last_write_time(model).time_since_epoch().count());
-  key += " score " + std::to_string(detector.inference.score_threshold) + " candidates " +
+  key += " score " + detector.inference.describeScoreThresholds() + " candidates " +
          std::to_string(detector.inference.candidate_threshold) + " nms " +
          std::to_string(detector.inference.nms_iou) + " max " + std::to_string(detector.inference.max_detections) +
          " data " + fs::absolute(ds.dir()).string() + " sequences";

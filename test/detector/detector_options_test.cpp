@@ -65,6 +65,8 @@ TEST(DetectorOptions, StageConfigsReadTheirBaseChain) {
   EXPECT_EQ(dark.inference.point_refine.faces, std::vector<ObjectClass>{ObjectClass::Car});
   EXPECT_FLOAT_EQ(robust.inference.score_threshold, 0.3f);
   EXPECT_FLOAT_EQ(dark.inference.score_threshold, 0.5f);
+  EXPECT_FLOAT_EQ(dark.inference.scoreThreshold(ObjectClass::Car), 0.4f);
+  EXPECT_FLOAT_EQ(robust.inference.scoreThreshold(ObjectClass::Car), 0.3f);
   EXPECT_DOUBLE_EQ(dark.train.sensor_augment.ray_drop_max, 0.3);
   EXPECT_DOUBLE_EQ(anchor.train.sensor_augment.object_zero_probability, 0.0);
   EXPECT_DOUBLE_EQ(dark.train.sensor_augment.object_zero_probability, 0.3);
@@ -181,6 +183,9 @@ TEST(DetectorOptions, EveryInferenceValueHasOneRangeAndARefusalNamesKeyValueAndR
   EXPECT_EQ(yamlError("inference: {threads: 65}"), "<string>: key 'inference.threads': must lie in [1, 64], got 65");
   EXPECT_EQ(yamlError("inference: {heading_from_velocity: {Car: -1}}"),
             "<string>: key 'inference.heading_from_velocity.Car': must be >= 0, got -1");
+  EXPECT_EQ(yamlError("inference: {class_score_threshold: {Car: 1.5}}"),
+            "<string>: key 'inference.class_score_threshold.Car': must lie in [0, 1], got 1.5");
+  EXPECT_EQ(yamlError("inference: {class_score_threshold: {Car: 0.4}}"), "");
 
   InferenceOptions o;
   EXPECT_NO_THROW(o.validate());

@@ -49,7 +49,7 @@ TEST(TrackerOptions, TheLwd3dConfigsAreTheDefaultsWithTheirOverrides) {
   pipeline.score_threshold = 0.05;
   pipeline.birth_score = {0.3, 0.3, 0.45};
   pipeline.max_age = 10;
-  pipeline.confirm_score = {0.5, 0.5, 0.5};
+  pipeline.confirm_score = {0.4, 0.5, 0.5};  // as models/lwd3d/detector.pt publishes
   pipeline.min_hits = {3, 3, 3};
   expectSame(loadTrackerOptions(dir + "tracker_lwd3d_pipeline.yaml"), pipeline);
 }

@@ -64,7 +64,7 @@ TEST(ShippedDetector, PublishesTheBlackCarAheadInAQueueInEveryFrame) {
       }
     published += found;
     EXPECT_TRUE(found) << "frame " << s.frame << ": no Car box on the black car " << a.x << " m ahead";
-    if (found) EXPECT_GE(best_score, options.inference.score_threshold);
+    if (found) EXPECT_GE(best_score, options.inference.scoreThreshold(ObjectClass::Car));
   });
   EXPECT_GE(frames_with_car, 15) << "the queue scene should put a car ahead in most frames";
   std::printf("  the black car ahead published in %d of %d frames\n", published, frames_with_car);

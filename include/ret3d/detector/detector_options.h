@@ -105,10 +105,20 @@ struct InferenceOptions {
   // The lowest published score: a box scoring less after NMS and refinement is dropped. An uncalibrated class's
   // candidates need it before NMS already (its score does not change after).
   float score_threshold = 0.3f;
+  // Per class, a published score other than score_threshold (YAML `class_score_threshold: {Car: 0.4}`): the classes'
+  // calibrated scores need not mean the same on real scans. A threshold from outside the model (the pipeline feeding
+  // its tracker, --score-threshold, dynamic_reconfigure: setScoreThreshold) applies to every class and clears these.
+  std::vector<std::pair<ObjectClass, double>> class_score_threshold;
+  // The lowest published score of class c (class_score_threshold, else score_threshold).
+  float scoreThreshold(ObjectClass c) const;
+  // Every class published from t.
+  void setScoreThreshold(float t);
+  // "0.5" or "0.5 (Car 0.4)": for logs and captions.
+  std::string describeScoreThresholds() const;
   // The network score a candidate of a calibrated class (point_refine.score_calibration) needs before NMS; its
-  // calibrated score, from the returns that hold the refined box, must then reach score_threshold. A far car's
+  // calibrated score, from the returns that hold the refined box, must then reach its class's score threshold. A far car's
   // network score is low (few returns in its cells) where its calibrated score need not be. Used as
-  // min(candidate_threshold, score_threshold).
+  // min(candidate_threshold, scoreThreshold(c)).
   float candidate_threshold = 0.05f;
   // The threshold a candidate of class c needs before NMS (the two above).
   float candidateThreshold(ObjectClass c) const;
