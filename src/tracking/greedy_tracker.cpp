@@ -88,7 +88,8 @@ std::vector<std::size_t> GreedyTracker::step(const std::vector<Box>& detections,
         track = &born.back();
       }
       updateTrack(*track, c, stamp, features ? features + c.index * feature_dim : nullptr, feature_dim);
-      if (track->confirmed) emit(*track, c, detections[c.index], sensor_to_fixed.linear(), frame);
+      if (track->confirmed && c.fixed.score >= options_.output_score.at(label))
+        emit(*track, c, detections[c.index], sensor_to_fixed.linear(), frame);
     }
   }
   ageTracks(track_matched, dt);

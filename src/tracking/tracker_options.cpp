@@ -31,6 +31,7 @@ TrackerOptions readTrackerOptions(YamlReader r) {
     getOneOrPerClass(r, "birth_score", &o.birth_score);
     getOneOrPerClass(r, "confirm_score", &o.confirm_score);
     getOneOrPerClass(r, "min_hits", &o.min_hits);
+    getOneOrPerClass(r, "output_score", &o.output_score);
     r.get("max_age", &o.max_age);
     r.get("max_time_gap", &o.max_time_gap);
     r.get("use_detection_velocity", &o.use_detection_velocity);
@@ -59,6 +60,7 @@ void validate(const TrackerOptions& o) {
   checkOptionPerClass("birth_score", o.birth_score, T::kScore);
   checkOptionPerClass("confirm_score", o.confirm_score, T::kScore);
   checkOptionPerClass("min_hits", o.min_hits, T::kMinHits);
+  checkOptionPerClass("output_score", o.output_score, T::kScore);
   checkOption("score_threshold", o.score_threshold, T::kScore);
   checkOption("max_age", o.max_age, T::kMaxAge);
   checkOption("max_time_gap", o.max_time_gap, T::kMaxTimeGap);

@@ -308,6 +308,39 @@ TEST(GreedyTracker, OnlyConfirmedTracksArePublished) {
   EXPECT_EQ(published_real, (std::vector<std::size_t>{2, 3, 4, 5, 6, 7, 8, 9}));
 }
 
+// output_score: a confirmed track goes on through weak detections with its id, publishing only its frames that score
+// output_score; another class without one publishes every matched frame.
+TEST(GreedyTracker, AConfirmedTrackPublishesOnlyItsFramesAboveOutputScore) {
+  TrackerOptions o;
+  o.score_threshold = 0.05;
+  o.birth_score = {0.3, 0.3, 0.3};
+  o.confirm_score = {0.5, 0.5, 0.5};
+  o.output_score = {0.0, 0.3, 0.0};
+  GreedyTracker tracker(o);
+  const Actor ped{ObjectClass::Pedestrian, 10, 0, 1, 0};
+  const Actor car{ObjectClass::Car, 20, 5, 10, 0};
+  const std::vector<float> scores{0.8f, 0.2f, 0.25f, 0.6f, 0.1f};
+  std::vector<std::size_t> ped_frames, car_frames;
+  std::uint32_t ped_id = 0;
+  for (std::size_t f = 0; f < scores.size(); ++f) {
+    const double t = 0.1 * static_cast<double>(f);
+    Box p = ped.at(t), c = car.at(t);
+    p.score = c.score = scores[f];
+    for (const Box& b : tracker.update({p, c}, t, Eigen::Isometry3d::Identity())) {
+      if (b.label == ObjectClass::Car) {
+        car_frames.push_back(f);
+        continue;
+      }
+      ped_frames.push_back(f);
+      if (ped_id == 0) ped_id = b.track_id;
+      EXPECT_EQ(b.track_id, ped_id) << "the pedestrian's track went on through its weak frames, frame " << f;
+    }
+  }
+  EXPECT_EQ(ped_frames, (std::vector<std::size_t>{0, 3}));
+  EXPECT_EQ(car_frames, (std::vector<std::size_t>{0, 1, 2, 3, 4}));
+  EXPECT_EQ(tracker.lastId(), 2u);  // one track each, never re-born
+}
+
 // A tentative track ends at its first miss: two hits, a gap, and it starts again from scratch (a new id).
 TEST(GreedyTracker, ATentativeTrackEndsAtItsFirstMiss) {
   TrackerOptions o;

@@ -23,6 +23,7 @@ void expectSame(const TrackerOptions& a, const TrackerOptions& b) {
     EXPECT_DOUBLE_EQ(a.birth_score.at(c), b.birth_score.at(c)) << className(c);
     EXPECT_DOUBLE_EQ(a.confirm_score.at(c), b.confirm_score.at(c)) << className(c);
     EXPECT_EQ(a.min_hits.at(c), b.min_hits.at(c)) << className(c);
+    EXPECT_DOUBLE_EQ(a.output_score.at(c), b.output_score.at(c)) << className(c);
   }
   EXPECT_DOUBLE_EQ(a.score_threshold, b.score_threshold);
   EXPECT_EQ(a.max_age, b.max_age);
@@ -51,6 +52,7 @@ TEST(TrackerOptions, TheLwd3dConfigsAreTheDefaultsWithTheirOverrides) {
   pipeline.max_age = 10;
   pipeline.confirm_score = {0.4, 0.5, 0.5};  // as models/lwd3d/detector.pt publishes
   pipeline.min_hits = {3, 3, 3};
+  pipeline.output_score = {0.0, 0.3, 0.0};
   expectSame(loadTrackerOptions(dir + "tracker_lwd3d_pipeline.yaml"), pipeline);
 }
 
@@ -64,6 +66,7 @@ TEST(TrackerOptions, ReadsEveryKey) {
       "max_age: 5\n"
       "confirm_score: {Pedestrian: 0.6}\n"
       "min_hits: 3\n"
+      "output_score: {Pedestrian: 0.3}\n"
       "max_time_gap: 0.5\n"
       "use_detection_velocity: false\n"
       "velocity_window: 3\n"
@@ -84,6 +87,8 @@ TEST(TrackerOptions, ReadsEveryKey) {
   EXPECT_DOUBLE_EQ(o.confirm_score.pedestrian, 0.6);
   EXPECT_DOUBLE_EQ(o.confirm_score.car, TrackerOptions().confirm_score.car);
   for (ObjectClass c : kDetectedClasses) EXPECT_EQ(o.min_hits.at(c), 3) << className(c);
+  EXPECT_DOUBLE_EQ(o.output_score.pedestrian, 0.3);
+  EXPECT_DOUBLE_EQ(o.output_score.car, 0.0);
   EXPECT_DOUBLE_EQ(o.max_time_gap, 0.5);
   EXPECT_FALSE(o.use_detection_velocity);
   EXPECT_EQ(o.velocity_window, 3);
@@ -112,6 +117,7 @@ TEST(TrackerOptions, InvalidValuesNameParameterValueAndAllowed) {
       {"min_hits: 0", "min_hits.Car", "0", "[1, 1000]"},
       {"min_hits: {Pedestrian: 2.5}", "min_hits.Pedestrian", "2.5", "an integer"},
       {"confirm_score: {Cyclist: .nan}", "confirm_score.Cyclist", "nan", "finite"},
+      {"output_score: {Pedestrian: .inf}", "output_score.Pedestrian", "inf", "finite"},
       {"max_age: -1", "max_age", "-1", "[0, 1000]"},
       {"max_age: 2.5", "max_age", "2.5", "an integer"},
       {"max_time_gap: 0", "max_time_gap", "0", "> 0"},

@@ -5,8 +5,8 @@
 // and matched to the tracks' centres by BEV distance within a class gate, greedily in descending score (or optimally,
 // Hungarian). Matched tracks take the detection; unmatched detections scoring at least birth_score start tracks with
 // fresh ids; unmatched tracks coast on their velocity for up to max_age frames without being output. A track's boxes
-// are output once it is confirmed (a detection scoring confirm_score, or min_hits consecutive matches from its birth);
-// a tentative track ends at its first miss.
+// are output once it is confirmed (a detection scoring confirm_score, or min_hits consecutive matches from its birth),
+// in the frames whose detection scores output_score; a tentative track ends at its first miss.
 #pragma once
 
 #include <array>

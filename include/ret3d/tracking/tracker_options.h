@@ -45,6 +45,11 @@ struct TrackerOptions {
   // every track is confirmed at birth.
   PerClass<double> confirm_score{0.0, 0.0, 0.0};
   PerClass<int> min_hits{1, 1, 1};
+  // A confirmed track's box is output in a frame only when its detection there scores at least output_score; below,
+  // the track is continued (matched, its history grown) without a box. Tracks are kept alive through weak detections
+  // (score_threshold), and output_score keeps a persistent false object's weak frames unpublished. Per class (YAML:
+  // one number for all, or a map by class); 0: every matched frame.
+  PerClass<double> output_score{0.0, 0.0, 0.0};
   // Frames a track may go unmatched and still be matched again; it coasts on its velocity meanwhile and is not output.
   // CenterPoint's Waymo max_age = 3 counts the matched frame too (2 coasting frames; ours counts misses only). On the
   // PointRCNN boxes of KITTI tracking 0001-0015 car ID switches went 179 / 122 / 105 / 99 for 1 / 3 / 5 / 10: 5
