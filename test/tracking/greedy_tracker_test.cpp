@@ -263,15 +263,20 @@ TEST(GreedyTracker, BirthScoreAndScoreThreshold) {
   EXPECT_TRUE(tracker.update({a}, 0.3, Eigen::Isometry3d::Identity()).empty());
 }
 
-// The publishing rule: a track's boxes are output from its confirming frame on (min_hits consecutive matches, or one
-// detection scoring confirm_score); a false box seen in one frame alone is never output.
-TEST(GreedyTracker, OnlyConfirmedTracksArePublished) {
+// The pipeline's publishing options: fed from 0.05, born from 0.3, confirmed by a score of 0.5 or min_hits matches.
+TrackerOptions publishingOptions(int min_hits) {
   TrackerOptions o;
   o.score_threshold = 0.05;
   o.birth_score = {0.3, 0.3, 0.3};
   o.confirm_score = {0.5, 0.5, 0.5};
-  o.min_hits = {3, 3, 3};
-  GreedyTracker tracker(o);
+  o.min_hits = {min_hits, min_hits, min_hits};
+  return o;
+}
+
+// The publishing rule: a track's boxes are output from its confirming frame on (min_hits consecutive matches, or one
+// detection scoring confirm_score); a false box seen in one frame alone is never output.
+TEST(GreedyTracker, OnlyConfirmedTracksArePublished) {
+  GreedyTracker tracker(publishingOptions(3));
   const Actor real{ObjectClass::Car, 10, 0, 10, 0};
   const Actor strong{ObjectClass::Pedestrian, 20, 5, 1, 0};
   std::vector<std::size_t> published_real;
@@ -311,10 +316,7 @@ TEST(GreedyTracker, OnlyConfirmedTracksArePublished) {
 // output_score: a confirmed track goes on through weak detections with its id, publishing only its frames that score
 // output_score; another class without one publishes every matched frame.
 TEST(GreedyTracker, AConfirmedTrackPublishesOnlyItsFramesAboveOutputScore) {
-  TrackerOptions o;
-  o.score_threshold = 0.05;
-  o.birth_score = {0.3, 0.3, 0.3};
-  o.confirm_score = {0.5, 0.5, 0.5};
+  TrackerOptions o = publishingOptions(1);
   o.output_score = {0.0, 0.3, 0.0};
   GreedyTracker tracker(o);
   const Actor ped{ObjectClass::Pedestrian, 10, 0, 1, 0};
