@@ -170,11 +170,10 @@ void InferenceOptions::setScoreThreshold(float t) {
 }
 
 std::string InferenceOptions::describeScoreThresholds() const {
-  std::string s = optionValueText(score_threshold);
-  for (std::size_t i = 0; i < class_score_threshold.size(); ++i)
-    s += std::string(i ? ", " : " (") + className(class_score_threshold[i].first) + " " +
-         optionValueText(class_score_threshold[i].second) + (i + 1 == class_score_threshold.size() ? ")" : "");
-  return s;
+  std::string classes;
+  for (const auto& [c, t] : class_score_threshold)
+    classes += (classes.empty() ? "" : ", ") + std::string(className(c)) + " " + optionValueText(t);
+  return optionValueText(score_threshold) + (classes.empty() ? "" : " (" + classes + ")");
 }
 
 float InferenceOptions::candidateThreshold(ObjectClass c) const {

@@ -107,7 +107,8 @@ OfflinePipeline::OfflinePipeline(const PipelineConfig& c) : stages_(c.stages) {
     }
     detector_ = std::make_unique<Detector>(o);
     desc << "; detector " << path << " (" << headTypeName(o.model.head) << " head, " << detector_->parameterCount()
-         << " parameters, score >= " << o.inference.describeScoreThresholds() << ", grid " << detector_->describeGrids() << ")";
+         << " parameters, score >= " << o.inference.describeScoreThresholds() << ", grid " << detector_->describeGrids()
+         << ")";
   }
   if (has(stages_, "intra")) {
     const std::string path =

@@ -23,15 +23,29 @@ PointCloud readBin(const std::string& path) {
   return c;
 }
 
-TEST(Detector, ReturnsBoxesWithOneFeatureRowEachAndTimesItsParts) {
+// A 32 m x 32 m grid around the sensor, every peak of an untrained network published, no ego box (the returns below
+// lie where KITTI's car would stand: every box counts here).
+DetectorOptions smallGridEveryPeak() {
   DetectorOptions o;
   o.model.geometry.x_min = -16, o.model.geometry.x_max = 16, o.model.geometry.y_min = -16, o.model.geometry.y_max = 16;
-  o.inference.score_threshold = 0.0f;  // untrained: every peak passes
-  o.inference.max_detections = 20;
-  o.inference.ego_box.reset();  // the returns lie where KITTI's car would stand: every box counts here
-  Detector d(o);
+  o.inference.score_threshold = 0.0f;
+  o.inference.ego_box.reset();
+  return o;
+}
+
+// 2000 returns on a 4 m x 5 m patch 1 m below the sensor.
+PointCloud patchOfReturns() {
   PointCloud cloud;
-  for (int i = 0; i < 2000; ++i) cloud.push_back({static_cast<float>(i % 40) * 0.1f, static_cast<float>(i / 40) * 0.1f, -1.0f, 0.5f});
+  for (int i = 0; i < 2000; ++i)
+    cloud.push_back({static_cast<float>(i % 40) * 0.1f, static_cast<float>(i / 40) * 0.1f, -1.0f, 0.5f});
+  return cloud;
+}
+
+TEST(Detector, ReturnsBoxesWithOneFeatureRowEachAndTimesItsParts) {
+  DetectorOptions o = smallGridEveryPeak();
+  o.inference.max_detections = 20;
+  Detector d(o);
+  const PointCloud cloud = patchOfReturns();
   const Detections det = d.detect(cloud);
   ASSERT_EQ(det.boxes.size(), 20u);
   EXPECT_EQ(static_cast<int>(det.feature_dim), d.featureDim());
@@ -117,14 +131,10 @@ TEST(Detector, CalibratedClassesArePublishedOnTheirCalibratedScore) {
 // class_score_threshold: one class published from its own score, the others from score_threshold; a threshold set
 // from outside the model (dynamic_reconfigure, the pipeline feeding its tracker) applies to every class.
 TEST(Detector, AClassWithItsOwnThresholdIsPublishedFromIt) {
-  DetectorOptions o;
-  o.model.geometry.x_min = -16, o.model.geometry.x_max = 16, o.model.geometry.y_min = -16, o.model.geometry.y_max = 16;
-  o.inference.score_threshold = 0.0f;  // untrained: every peak passes
+  DetectorOptions o = smallGridEveryPeak();
   o.inference.max_candidates = 100000;
   o.inference.max_detections = 100000;
-  o.inference.ego_box.reset();
-  PointCloud cloud;
-  for (int i = 0; i < 2000; ++i) cloud.push_back({static_cast<float>(i % 40) * 0.1f, static_cast<float>(i / 40) * 0.1f, -1.0f, 0.5f});
+  const PointCloud cloud = patchOfReturns();
   auto count = [&](const Detections& d, ObjectClass c) {
     return std::count_if(d.boxes.begin(), d.boxes.end(), [&](const Box& b) { return b.label == c; });
   };

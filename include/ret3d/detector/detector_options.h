@@ -116,8 +116,8 @@ struct InferenceOptions {
   // "0.5" or "0.5 (Car 0.4)": for logs and captions.
   std::string describeScoreThresholds() const;
   // The network score a candidate of a calibrated class (point_refine.score_calibration) needs before NMS; its
-  // calibrated score, from the returns that hold the refined box, must then reach its class's score threshold. A far car's
-  // network score is low (few returns in its cells) where its calibrated score need not be. Used as
+  // calibrated score, from the returns that hold the refined box, must then reach its class's score threshold. A far
+  // car's network score is low (few returns in its cells) where its calibrated score need not be. Used as
   // min(candidate_threshold, scoreThreshold(c)).
   float candidate_threshold = 0.05f;
   // The threshold a candidate of class c needs before NMS (the two above).
