@@ -13,10 +13,16 @@ label_2, one file per scan, for `ret3d train detector --data ROOT --labels-cover
 - objects: only cars the detector is sure of (score >= --car-score, at least --car-points returns inside; their
   heading fitted to the returns' outline by the detector's point refinement) are written as Car, the rest of the
   objects come from the simulated folders trained beside, and from ground-truth sampling, which pastes them into
-  these real scenes.
+  these real scenes;
+- tracked cars (--tracks, consecutive scans only): a car that the pipeline tracked over many frames with a high mean
+  score (`ret3d autolabel`'s smoothed tracks, --track-frames, --track-score) is a Car label in every frame of its
+  track whose box holds --track-points returns, far and partly hidden frames included; a single frame's confident
+  box is never enough. The detector's boxes on a tracked car are neither background nor DontCare; the boxes of
+  shorter or weaker car tracks are DontCare.
 
 Usage: scripts/real_negatives.py ROOT PRED [--grow 0.3] [--min-score 0.1] [--car-score 1.1] [--car-points 30]
-Prints how many boxes per class became background and DontCare.
+       [--tracks LABEL_02_FILE --tracks-first-frame N]
+Prints how many boxes per class became background, DontCare and labels.
 """
 import argparse
 import glob
@@ -59,6 +65,31 @@ def returns_in(pts, b):
     return int(((np.abs(u) <= l / 2) & (np.abs(v) <= w / 2) & (near[:, 2] > zb + 0.3) & (near[:, 2] < zb + h)).sum())
 
 
+def read_tracks(path, first_frame, min_frames, min_score):
+    """`ret3d autolabel` KITTI tracking labels -> {object frame: [(kept, h, w, l, x, y, z, ry)]} of Car tracks.
+
+    kept: the track has at least min_frames frames and a mean score of at least min_score (its last column)."""
+    rows = [l.split() for l in open(path) if len(l.split()) >= 17]
+    frames = {}
+    for f in rows:
+        if f[2] == "Car":
+            frames.setdefault(int(f[1]), []).append(f)
+    out = {}
+    for track in frames.values():
+        kept = len(track) >= min_frames and float(track[0][17] if len(track[0]) > 17 else 0.0) >= min_score
+        for f in track:
+            box = (kept,) + tuple(float(v) for v in f[10:17])
+            out.setdefault("%06d" % (first_frame + int(f[0])), []).append(box)
+    return out
+
+
+def camera_box_to_velo(box, cam_to_velo):
+    """(h, w, l, x, y, z, ry) in camera coordinates -> (x, y, z_bottom, l, w, h, yaw) in the LiDAR frame."""
+    h, w, l, x, y, z, ry = box
+    c = cam_to_velo @ np.array([x, y, z, 1.0])
+    return (c[0], c[1], c[2], l, w, h, -ry - math.pi / 2)
+
+
 def embedded_in_structure(pts, b):
     """True when a small-object box stands in a wall, hedge or under a tree rather than in free space."""
     cls, score, x, y, zb, l, w, h, yaw = b
@@ -89,8 +120,14 @@ def main():
                     help="boxes scored lower are background too (the detector already calls them so)")
     ap.add_argument("--car-score", type=float, default=1.1, help="cars scored this or more are labels (default: none)")
     ap.add_argument("--car-points", type=int, default=30, help="... with at least this many returns in the box")
+    ap.add_argument("--tracks", help="`ret3d autolabel` label_02 file of the consecutive scans among ROOT's frames")
+    ap.add_argument("--tracks-first-frame", type=int, default=0, help="ROOT's frame number of the tracks' frame 0")
+    ap.add_argument("--track-frames", type=int, default=8, help="a car track is a label from this many frames")
+    ap.add_argument("--track-score", type=float, default=0.5, help="... with at least this mean score")
+    ap.add_argument("--track-points", type=int, default=10, help="... in its frames with this many returns")
     ap.add_argument("--debug-out", help="also write the boxes left as background here (KITTI result files)")
     a = ap.parse_args()
+    tracks = read_tracks(a.tracks, a.tracks_first_frame, a.track_frames, a.track_score) if a.tracks else {}
     tr = os.path.join(a.root, "training") if os.path.isdir(os.path.join(a.root, "training")) else a.root
     scans = sorted(glob.glob(os.path.join(tr, "velodyne", "*.bin")))
     if not scans:
@@ -106,8 +143,23 @@ def main():
         pred_file = os.path.join(a.pred, frame + ".txt")
         raw = [l for l in open(pred_file) if len(l.split()) >= 16] if os.path.exists(pred_file) else []
         frame_boxes = read_boxes(pred_file, cam_to_velo)  # one per line of raw, in order
+        tracked = []  # (x, y, reach) of this frame's tracked cars in the LiDAR frame
+        for kept, *cam in tracks.get(frame, []):
+            x, y, zb, l, w, h, yaw = camera_box_to_velo(cam, cam_to_velo)
+            tracked.append((x, y, max(l, w) / 2 + 0.5))
+            label = kept and returns_in(pts, ("Car", 1.0, x, y, zb, l, w, h, yaw)) >= a.track_points
+            key = ("Car", "tracked" if label else "track DontCare")
+            counts[key] = counts.get(key, 0) + 1
+            hc, wc, lc, xc, yc, zc, ry = cam
+            if label:
+                lines.append("Car 0.00 0 -10 0 0 0 0 %.3f %.3f %.3f %.3f %.3f %.3f %.4f\n" % (hc, wc, lc, xc, yc, zc, ry))
+            else:
+                lines.append("DontCare 0.00 0 -10 0 0 0 0 %.3f %.3f %.3f %.3f %.3f %.3f %.4f\n" %
+                             (hc + 0.2, wc + 2 * a.grow, lc + 2 * a.grow, xc, yc, zc, ry))
         for line, b in zip(raw, frame_boxes):
             cls = b[0]
+            if any(math.hypot(b[2] - x, b[3] - y) < reach for x, y, reach in tracked):
+                continue  # on a tracked car: its label or DontCare is written above
             background = b[1] < a.min_score or (cls in ("Pedestrian", "Cyclist") and embedded_in_structure(pts, b))
             key = (cls, "background" if background else "DontCare")
             counts[key] = counts.get(key, 0) + 1

@@ -69,6 +69,13 @@ Straights drawMainRoad(Scene& scene, const RoadConfig& rc, Rng& rng, double reac
   main.center = Path(pts).slice(0, Path(pts).length(), 1.0);
   main.z.assign(main.center.points().size(), 0.0);
   scene.ego_start = rc.margin;
+  if (rc.hill_amplitude.hi > 0) {  // drawn only for hills, so that flat scenes keep their random sequence
+    const double amplitude = draw(rng, rc.hill_amplitude), wavelength = draw(rng, rc.hill_wavelength);
+    const double phase = rng.uniform(0, 2 * M_PI);
+    const auto& st = main.center.stations();
+    for (std::size_t i = 0; i < main.z.size(); ++i) main.z[i] = amplitude * std::sin(2 * M_PI * st[i] / wavelength + phase);
+    scene.flat = amplitude == 0.0;
+  }
   return straights;
 }
 

@@ -56,6 +56,8 @@ void readRoad(YamlReader r, RoadConfig* o) {
   r.get("marking_dash", &o->marking_dash, 0.5, 20);
   r.get("marking_gap", &o->marking_gap, 0, 50);
   r.get("crosswalk_spacing", &o->crosswalk_spacing, 0, kBig);
+  readRange(r, "hill_amplitude", &o->hill_amplitude, 0, 20);
+  readRange(r, "hill_wavelength", &o->hill_wavelength, 20, kBig);
   r.finish();
 }
 

@@ -1,5 +1,5 @@
-// Cars of every paint and the detection floor, stop-and-go queues, and roadside structures of many sizes
-// (docs/SIMULATOR.md "Paints and the detection floor", "Queues", "Roadside structures").
+// Cars of every paint and the detection floor, stop-and-go queues, hills, and roadside structures of many sizes
+// (docs/SIMULATOR.md "Paints and the detection floor", "Queues", "Hills", "Roadside structures").
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -140,6 +140,38 @@ TEST(Queue, ALabelledCarStandsThreeToEightMetresAheadInMostFrames) {
   EXPECT_GE(ahead_frames, 0.8 * frames);
   // Trucks and vans around, labelled with KITTI's types.
   EXPECT_GT(types["Truck"] + types["Van"], 0);
+}
+
+// How far the labelled cars 20-45 m from the sensor stand from the flat ground under it (1.73 m below): the largest
+// |bottom + 1.73| over two short drives of the preset.
+double largestGroundOffsetAhead(const std::string& preset_name) {
+  test::TempDir out;
+  SimOptions o;
+  o.config = preset(preset_name);
+  o.sensor = sensorByName("hdl64e", RET3D_SOURCE_DIR);
+  o.out_dir = out.path();
+  o.frames = 10;
+  o.threads = 2;
+  double largest = 0;
+  for (std::uint64_t seed : {41u, 42u}) {
+    o.seed = seed;
+    simulateSequence(o, 0);
+    for (const test::SimInfoRow& r : test::readSimInfo(out / "training/sim_info/0000.txt")) {
+      const double range = std::hypot(r.box.x, r.box.y);
+      if (r.type == "Car" && range > 20 && range < 45) largest = std::max(largest, std::abs(r.box.bottom() + 1.73));
+    }
+  }
+  return largest;
+}
+
+TEST(Hills, CarsAheadStandAboveOrBelowTheSensorsFlatGroundOnlyOnHills) {
+  const SimConfig hills = preset("hills");
+  EXPECT_GT(hills.road.hill_amplitude.lo, 0.0);
+  EXPECT_EQ(preset("urban_street").road.hill_amplitude.hi, 0.0);
+  // Flat streets: the mount's height jitter and road roughness only (0.18 m on these drives).
+  EXPECT_LT(largestGroundOffsetAhead("urban_street"), 0.35);
+  // Hills: somewhere a car 20-45 m away stands half a metre or more off it (1.12 m on these drives).
+  EXPECT_GT(largestGroundOffsetAhead("hills"), 0.5);
 }
 
 TEST(Roadside, TrunksPolesPostsAndBicyclesOfManySizesStandWhereRecorded) {

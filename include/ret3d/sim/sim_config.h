@@ -42,6 +42,11 @@ struct RoadConfig {
   double margin = 160;                  // road before the ego start and after its furthest reach
   double marking_dash = 3.0, marking_gap = 6.0;
   double crosswalk_spacing = 120;       // mid-block pedestrian crossings (0 = none)
+  // Hills: the drawn main road rises and falls along its length as a sine of this amplitude (m) and wavelength (m),
+  // both drawn per scene; everything on or beside it follows its height and the sensor stays level, so the cars ahead
+  // and behind stand above or below the flat ground (config/sim/hills.yaml). 0..0 = flat (nothing drawn).
+  Range hill_amplitude{0, 0};
+  Range hill_wavelength{150, 400};
 };
 
 struct GroundConfig {
