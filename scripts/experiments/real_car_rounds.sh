@@ -1,12 +1,14 @@
 #!/usr/bin/env bash
-# One more epoch of the default detector aimed at real cars, two ways (docs/RESULTS.md, "Real scans", tried and
+# One more epoch of the default detector aimed at real cars, three ways (docs/RESULTS.md, "Real scans", tried and
 # dropped), each with its score calibration refitted as scripts/train_default.sh's dark_round does:
 #   tracked  today's simulator's training sets + training_extra + the 37 unlabelled real scans, the 22 consecutive
 #            ones carrying the cars the whole pipeline tracked over them (`ret3d autolabel`, then
 #            scripts/real_negatives.py --tracks; config/detector/lwd3d_anchor_tracked.yaml);
 #   cabin    today's simulator's training sets (car windows returning from the cabin) + training_extra, no real scans
-#            (config/detector/lwd3d_anchor_cabin.yaml).
-#   scripts/experiments/real_car_rounds.sh tracked|cabin
+#            (config/detector/lwd3d_anchor_cabin.yaml);
+#   hills    the cabin round's sets plus hilly streets (config/sim/hills.yaml), at half the learning rate
+#            (config/detector/lwd3d_anchor_hills.yaml).
+#   scripts/experiments/real_car_rounds.sh tracked|cabin|hills
 # Writes OUT/<round>/models/{detector,intra_rm,inter_rm}.pt (IntraRM and InterRM are models/lwd3d's), to be measured
 # with `scripts/experiments/real_scans.sh OUT/<round>/models`. Environment: OUT (default out/real_car_rounds).
 set -eo pipefail
@@ -15,7 +17,7 @@ set +u; source scripts/env.sh; set -u
 source scripts/simulate_once.sh
 source scripts/real_folder.sh
 source scripts/experiments/refit_calibration.sh
-ROUND=${1:?tracked or cabin}
+ROUND=${1:?tracked, cabin or hills}
 OUT=${OUT:-out/real_car_rounds}
 DATA_DIR=${RET3D_SHARED_DATA:-$PWD/../shared/data}
 W=$OUT/$ROUND
@@ -30,6 +32,10 @@ simulate_once data/sim8_relation_urban config/sim/urban_street.yaml 12 80 3000 "
 TRAIN=(--data data/sim8_train_urban data/sim8_train_highway data/sim8_train_queue "$DATA_DIR/kitti_object/training_extra")
 WEIGHTS=(1 1 1 40)
 COVER=(all all all camera)
+if [ "$ROUND" = hills ]; then
+  simulate_once data/sim8_train_hills config/sim/hills.yaml 16 80 1500 "$OUT/sim8_train_hills.log"
+  TRAIN=("${TRAIN[@]:0:4}" data/sim8_train_hills "${TRAIN[@]:4}"); WEIGHTS=(1 1 1 1 40); COVER=(all all all all camera)
+fi
 if [ "$ROUND" = tracked ]; then
   # The 37 real scans in an object layout (the 22 consecutive ones as frames 900000-900021), labelled from the default
   # detector's boxes and the pipeline's tracks over the 22.
