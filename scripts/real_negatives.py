@@ -65,6 +65,11 @@ def returns_in(pts, b):
     return int(((np.abs(u) <= l / 2) & (np.abs(v) <= w / 2) & (near[:, 2] > zb + 0.3) & (near[:, 2] < zb + h)).sum())
 
 
+def label_line(kind, h, w, l, x, y, z, ry):
+    """A KITTI label line of a box in camera coordinates (no 2D box, alpha unknown)."""
+    return "%s 0.00 0 -10 0 0 0 0 %.3f %.3f %.3f %.3f %.3f %.3f %.4f\n" % (kind, h, w, l, x, y, z, ry)
+
+
 def read_tracks(path, first_frame, min_frames, min_score):
     """`ret3d autolabel` KITTI tracking labels -> {object frame: [(kept, h, w, l, x, y, z, ry)]} of Car tracks.
 
@@ -152,10 +157,9 @@ def main():
             counts[key] = counts.get(key, 0) + 1
             hc, wc, lc, xc, yc, zc, ry = cam
             if label:
-                lines.append("Car 0.00 0 -10 0 0 0 0 %.3f %.3f %.3f %.3f %.3f %.3f %.4f\n" % (hc, wc, lc, xc, yc, zc, ry))
+                lines.append(label_line("Car", hc, wc, lc, xc, yc, zc, ry))
             else:
-                lines.append("DontCare 0.00 0 -10 0 0 0 0 %.3f %.3f %.3f %.3f %.3f %.3f %.4f\n" %
-                             (hc + 0.2, wc + 2 * a.grow, lc + 2 * a.grow, xc, yc, zc, ry))
+                lines.append(label_line("DontCare", hc + 0.2, wc + 2 * a.grow, lc + 2 * a.grow, xc, yc, zc, ry))
         for line, b in zip(raw, frame_boxes):
             cls = b[0]
             if any(math.hypot(b[2] - x, b[3] - y) < reach for x, y, reach in tracked):
@@ -174,10 +178,9 @@ def main():
             ry = -yaw - math.pi / 2
             if cls == "Car" and score >= a.car_score and returns_in(pts, b) >= a.car_points:
                 counts[(cls, "label")] = counts.get((cls, "label"), 0) + 1
-                lines.append("Car 0.00 0 -10 0 0 0 0 %.3f %.3f %.3f %.3f %.3f %.3f %.4f\n" % (h, w, l, c[0], c[1], c[2], ry))
+                lines.append(label_line("Car", h, w, l, c[0], c[1], c[2], ry))
                 continue
-            lines.append("DontCare 0.00 0 -10 0 0 0 0 %.3f %.3f %.3f %.3f %.3f %.3f %.4f\n" %
-                         (h + 0.2, w + 2 * a.grow, l + 2 * a.grow, c[0], c[1], c[2], ry))
+            lines.append(label_line("DontCare", h + 0.2, w + 2 * a.grow, l + 2 * a.grow, c[0], c[1], c[2], ry))
         with open(os.path.join(tr, "label_2", frame + ".txt"), "w") as f:
             f.writelines(lines)
     for k in sorted(counts):

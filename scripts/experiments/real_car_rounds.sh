@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# One more epoch of the default detector aimed at real cars, three ways (docs/RESULTS.md, "Real scans", tried and
+# One or two more epochs of the default detector aimed at real cars, four ways (docs/RESULTS.md, "Real scans", tried and
 # dropped), each with its score calibration refitted as scripts/train_default.sh's dark_round does:
 #   tracked  today's simulator's training sets + training_extra + the 37 unlabelled real scans, the 22 consecutive
 #            ones carrying the cars the whole pipeline tracked over them (`ret3d autolabel`, then
@@ -7,8 +7,10 @@
 #   cabin    today's simulator's training sets (car windows returning from the cabin) + training_extra, no real scans
 #            (config/detector/lwd3d_anchor_cabin.yaml);
 #   hills    the cabin round's sets plus hilly streets (config/sim/hills.yaml), at half the learning rate
-#            (config/detector/lwd3d_anchor_hills.yaml).
-#   scripts/experiments/real_car_rounds.sh tracked|cabin|hills
+#            (config/detector/lwd3d_anchor_hills.yaml);
+#   hills2   the same sets, hills weighted twice, two epochs at the dark round's rate with every scene moved up or
+#            down by up to 0.6 m (config/detector/lwd3d_anchor_hills2.yaml).
+#   scripts/experiments/real_car_rounds.sh tracked|cabin|hills|hills2
 # Writes OUT/<round>/models/{detector,intra_rm,inter_rm}.pt (IntraRM and InterRM are models/lwd3d's), to be measured
 # with `scripts/experiments/real_scans.sh OUT/<round>/models`. Environment: OUT (default out/real_car_rounds).
 set -eo pipefail
@@ -17,7 +19,7 @@ set +u; source scripts/env.sh; set -u
 source scripts/simulate_once.sh
 source scripts/real_folder.sh
 source scripts/experiments/refit_calibration.sh
-ROUND=${1:?tracked, cabin or hills}
+ROUND=${1:?tracked, cabin, hills or hills2}
 OUT=${OUT:-out/real_car_rounds}
 DATA_DIR=${RET3D_SHARED_DATA:-$PWD/../shared/data}
 W=$OUT/$ROUND
@@ -29,12 +31,14 @@ simulate_once data/sim8_relation_urban config/sim/urban_street.yaml 12 80 3000 "
 [ -f data/gtdb/sim8_train.gtdb ] || ret3d train gtdb --data data/sim8_train_urban data/sim8_train_highway \
   data/sim8_train_queue --config config/detector/lwd3d_anchor_robust.yaml --out data/gtdb/sim8_train.gtdb \
   >"$OUT/gtdb.log" 2>&1
-TRAIN=(--data data/sim8_train_urban data/sim8_train_highway data/sim8_train_queue "$DATA_DIR/kitti_object/training_extra")
+TRAIN=(--data data/sim8_train_urban data/sim8_train_highway data/sim8_train_queue
+  "$DATA_DIR/kitti_object/training_extra")
 WEIGHTS=(1 1 1 40)
 COVER=(all all all camera)
-if [ "$ROUND" = hills ]; then
+if [ "$ROUND" = hills ] || [ "$ROUND" = hills2 ]; then
   simulate_once data/sim8_train_hills config/sim/hills.yaml 16 80 1500 "$OUT/sim8_train_hills.log"
   TRAIN=("${TRAIN[@]:0:4}" data/sim8_train_hills "${TRAIN[@]:4}"); WEIGHTS=(1 1 1 1 40); COVER=(all all all all camera)
+  [ "$ROUND" = hills2 ] && WEIGHTS=(1 1 1 2 40)
 fi
 if [ "$ROUND" = tracked ]; then
   # The 37 real scans in an object layout (the 22 consecutive ones as frames 900000-900021), labelled from the default

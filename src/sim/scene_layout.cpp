@@ -73,7 +73,8 @@ Straights drawMainRoad(Scene& scene, const RoadConfig& rc, Rng& rng, double reac
     const double amplitude = draw(rng, rc.hill_amplitude), wavelength = draw(rng, rc.hill_wavelength);
     const double phase = rng.uniform(0, 2 * M_PI);
     const auto& st = main.center.stations();
-    for (std::size_t i = 0; i < main.z.size(); ++i) main.z[i] = amplitude * std::sin(2 * M_PI * st[i] / wavelength + phase);
+    for (std::size_t i = 0; i < main.z.size(); ++i)
+      main.z[i] = amplitude * std::sin(2 * M_PI * st[i] / wavelength + phase);
     scene.flat = amplitude == 0.0;
   }
   return straights;

@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include <gtest/gtest.h>
+#include <torch/torch.h>
 
 #include "support/test_util.h"
 
@@ -103,13 +104,15 @@ TEST(Detector, CalibratedClassesArePublishedOnTheirCalibratedScore) {
   o.inference.max_detections = 100000;
   o.inference.score_threshold = 0.9f;  // above any score of an untrained network
   o.inference.candidate_threshold = 0.0f;
-  // A dense block of returns, 4 x 2 m and as tall as the grid's heights (-3 to 1 m), so that every box the untrained
-  // network places over it holds returns, whatever its random height.
+  // A dense wall of returns, 4 m deep across the whole grid and as tall as its heights (-3 to 1 m), so that every box
+  // the untrained network places over it holds returns, whatever its random size and height. (libtorch seeds its
+  // generator anew in each process: the network is seeded here, and the wall is wide enough for any seed.)
+  torch::manual_seed(11);
   PointCloud cloud;
   for (int i = 0; i < 40; ++i)
-    for (int j = 0; j < 20; ++j)
+    for (int j = 0; j < 160; ++j)
       for (int k = 0; k < 20; ++k)
-        cloud.push_back({2.0f + 0.1f * i, -1.0f + 0.1f * j, -2.95f + 0.2f * k, 0.5f});
+        cloud.push_back({2.0f + 0.1f * i, -8.0f + 0.1f * j, -2.95f + 0.2f * k, 0.5f});
   EXPECT_TRUE(Detector(o).detect(cloud).boxes.empty());  // uncalibrated: the network's scores alone
   // Calibrated: sigmoid(10 log(1 + n) - 3): 0.05 for a box without returns, 0.98 from one return on (the untrained
   // network's boxes have random sizes, so the test asks no more of them than to hold a return).
