@@ -377,7 +377,13 @@ class BagChecker {
     for (const CloudSeen& c : clouds_) {
       if (c.frame.empty() || c.frame == fixed_frame) continue;
       std::string error;
-      if (!tf_buffer_.canTransform(fixed_frame, c.frame, c.stamp, &error)) {
+      bool placeable = false;
+      try {
+        placeable = tf_buffer_.canTransform(fixed_frame, c.frame, c.stamp, &error);
+      } catch (const std::runtime_error& e) {  // a stamp decades from the transforms' (ros::Duration overflows)
+        error = e.what();
+      }
+      if (!placeable) {
         problems_.add("cloud " + std::to_string(c.index) + " (stamp " + stampString(c.stamp) + "): no transform " +
                       fixed_frame + " -> " + c.frame + " at its stamp: " + error);
       }
@@ -439,9 +445,17 @@ class BagChecker {
         }
         last = t.header.stamp;
       }
-      if (!tf_buffer_.setTransform(t, "bag", is_static)) {
+      // A stamp decades from the others overflows ros::Duration inside tf2: listed like any rejected transform.
+      std::string why = "empty frame, NaN or self-transform";
+      bool set = false;
+      try {
+        set = tf_buffer_.setTransform(t, "bag", is_static);
+      } catch (const std::runtime_error& e) {
+        why = e.what();
+      }
+      if (!set) {
         problems_.add(topic + ": transform " + t.header.frame_id + " -> " + t.child_frame_id + " at " +
-                      stampString(t.header.stamp) + " rejected by tf2 (empty frame, NaN or self-transform)");
+                      stampString(t.header.stamp) + " rejected by tf2 (" + why + ")");
       }
     }
   }
