@@ -35,6 +35,13 @@ import numpy as np
 from fit_score_calibration import load_calib  # camera (rectified) -> LiDAR, from a KITTI calib file
 
 
+def camera_box_to_velo(box, cam_to_velo):
+    """(h, w, l, x, y, z, ry) in camera coordinates -> (x, y, z_bottom, l, w, h, yaw) in the LiDAR frame."""
+    h, w, l, x, y, z, ry = box
+    c = cam_to_velo @ np.array([x, y, z, 1.0])
+    return (c[0], c[1], c[2], l, w, h, -ry - math.pi / 2)
+
+
 def read_boxes(path, cam_to_velo):
     """KITTI result lines -> (class, score, x, y, z_bottom, l, w, h, yaw) in the LiDAR frame."""
     out = []
@@ -44,10 +51,7 @@ def read_boxes(path, cam_to_velo):
         f = line.split()
         if len(f) < 16:
             continue
-        h, w, l = float(f[8]), float(f[9]), float(f[10])
-        c = cam_to_velo @ np.array([float(f[11]), float(f[12]), float(f[13]), 1.0])
-        yaw = -float(f[14]) - math.pi / 2
-        out.append((f[0], float(f[15]), c[0], c[1], c[2], l, w, h, yaw))
+        out.append((f[0], float(f[15])) + camera_box_to_velo([float(v) for v in f[8:15]], cam_to_velo))
     return out
 
 
@@ -74,10 +78,9 @@ def read_tracks(path, first_frame, min_frames, min_score):
     """`ret3d autolabel` KITTI tracking labels -> {object frame: [(kept, h, w, l, x, y, z, ry)]} of Car tracks.
 
     kept: the track has at least min_frames frames and a mean score of at least min_score (its last column)."""
-    rows = [l.split() for l in open(path) if len(l.split()) >= 17]
     frames = {}
-    for f in rows:
-        if f[2] == "Car":
+    for f in (line.split() for line in open(path)):
+        if len(f) >= 17 and f[2] == "Car":
             frames.setdefault(int(f[1]), []).append(f)
     out = {}
     for track in frames.values():
@@ -86,13 +89,6 @@ def read_tracks(path, first_frame, min_frames, min_score):
             box = (kept,) + tuple(float(v) for v in f[10:17])
             out.setdefault("%06d" % (first_frame + int(f[0])), []).append(box)
     return out
-
-
-def camera_box_to_velo(box, cam_to_velo):
-    """(h, w, l, x, y, z, ry) in camera coordinates -> (x, y, z_bottom, l, w, h, yaw) in the LiDAR frame."""
-    h, w, l, x, y, z, ry = box
-    c = cam_to_velo @ np.array([x, y, z, 1.0])
-    return (c[0], c[1], c[2], l, w, h, -ry - math.pi / 2)
 
 
 def embedded_in_structure(pts, b):

@@ -31,15 +31,17 @@ simulate_once data/sim8_relation_urban config/sim/urban_street.yaml 12 80 3000 "
 [ -f data/gtdb/sim8_train.gtdb ] || ret3d train gtdb --data data/sim8_train_urban data/sim8_train_highway \
   data/sim8_train_queue --config config/detector/lwd3d_anchor_robust.yaml --out data/gtdb/sim8_train.gtdb \
   >"$OUT/gtdb.log" 2>&1
-TRAIN=(--data data/sim8_train_urban data/sim8_train_highway data/sim8_train_queue
-  "$DATA_DIR/kitti_object/training_extra")
-WEIGHTS=(1 1 1 40)
-COVER=(all all all camera)
+# The simulated sets (weight 1, labels all around; hills2 weighs the hills twice), then training_extra (camera view).
+SIM=(data/sim8_train_urban data/sim8_train_highway data/sim8_train_queue)
+WEIGHTS=(1 1 1)
 if [ "$ROUND" = hills ] || [ "$ROUND" = hills2 ]; then
   simulate_once data/sim8_train_hills config/sim/hills.yaml 16 80 1500 "$OUT/sim8_train_hills.log"
-  TRAIN=("${TRAIN[@]:0:4}" data/sim8_train_hills "${TRAIN[@]:4}"); WEIGHTS=(1 1 1 1 40); COVER=(all all all all camera)
-  [ "$ROUND" = hills2 ] && WEIGHTS=(1 1 1 2 40)
+  SIM+=(data/sim8_train_hills)
+  if [ "$ROUND" = hills2 ]; then WEIGHTS+=(2); else WEIGHTS+=(1); fi
 fi
+TRAIN=(--data "${SIM[@]}" "$DATA_DIR/kitti_object/training_extra")
+WEIGHTS+=(40)
+COVER=("${SIM[@]/*/all}" camera)
 if [ "$ROUND" = tracked ]; then
   # The 37 real scans in an object layout (the 22 consecutive ones as frames 900000-900021), labelled from the default
   # detector's boxes and the pipeline's tracks over the 22.
