@@ -42,16 +42,15 @@ def camera_box_to_velo(box, cam_to_velo):
     return (c[0], c[1], c[2], l, w, h, -ry - math.pi / 2)
 
 
-def read_boxes(path, cam_to_velo):
-    """KITTI result lines -> (class, score, x, y, z_bottom, l, w, h, yaw) in the LiDAR frame."""
+def read_results(path):
+    """KITTI result lines -> [(line, class, score, (h, w, l, x, y, z, ry) in camera coordinates)]."""
     out = []
     if not os.path.exists(path):
         return out
     for line in open(path):
         f = line.split()
-        if len(f) < 16:
-            continue
-        out.append((f[0], float(f[15])) + camera_box_to_velo([float(v) for v in f[8:15]], cam_to_velo))
+        if len(f) >= 16:
+            out.append((line, f[0], float(f[15]), [float(v) for v in f[8:15]]))
     return out
 
 
@@ -138,12 +137,8 @@ def main():
     for scan in scans:
         frame = os.path.splitext(os.path.basename(scan))[0]
         cam_to_velo = load_calib(os.path.join(tr, "calib", frame + ".txt"))
-        velo_to_cam = np.linalg.inv(cam_to_velo)
         pts = np.fromfile(scan, dtype=np.float32).reshape(-1, 4)[:, :3].astype(np.float64)
         lines = []
-        pred_file = os.path.join(a.pred, frame + ".txt")
-        raw = [l for l in open(pred_file) if len(l.split()) >= 16] if os.path.exists(pred_file) else []
-        frame_boxes = read_boxes(pred_file, cam_to_velo)  # one per line of raw, in order
         tracked = []  # (x, y, reach) of this frame's tracked cars in the LiDAR frame
         for kept, *cam in tracks.get(frame, []):
             x, y, zb, l, w, h, yaw = camera_box_to_velo(cam, cam_to_velo)
@@ -156,11 +151,11 @@ def main():
                 lines.append(label_line("Car", hc, wc, lc, xc, yc, zc, ry))
             else:
                 lines.append(label_line("DontCare", hc + 0.2, wc + 2 * a.grow, lc + 2 * a.grow, xc, yc, zc, ry))
-        for line, b in zip(raw, frame_boxes):
-            cls = b[0]
+        for line, cls, score, cam in read_results(os.path.join(a.pred, frame + ".txt")):
+            b = (cls, score) + camera_box_to_velo(cam, cam_to_velo)  # (class, score, x, y, z_bottom, l, w, h, yaw)
             if any(math.hypot(b[2] - x, b[3] - y) < reach for x, y, reach in tracked):
                 continue  # on a tracked car: its label or DontCare is written above
-            background = b[1] < a.min_score or (cls in ("Pedestrian", "Cyclist") and embedded_in_structure(pts, b))
+            background = score < a.min_score or (cls in ("Pedestrian", "Cyclist") and embedded_in_structure(pts, b))
             key = (cls, "background" if background else "DontCare")
             counts[key] = counts.get(key, 0) + 1
             if background:
@@ -169,14 +164,12 @@ def main():
                     with open(os.path.join(a.debug_out, frame + ".txt"), "a") as f:
                         f.write(line)
                 continue
-            _, score, x, y, zb, l, w, h, yaw = b
-            c = velo_to_cam @ np.array([x, y, zb, 1.0])
-            ry = -yaw - math.pi / 2
+            h, w, l, x, y, z, ry = cam
             if cls == "Car" and score >= a.car_score and returns_in(pts, b) >= a.car_points:
                 counts[(cls, "label")] = counts.get((cls, "label"), 0) + 1
-                lines.append(label_line("Car", h, w, l, c[0], c[1], c[2], ry))
+                lines.append(label_line("Car", h, w, l, x, y, z, ry))
                 continue
-            lines.append(label_line("DontCare", h + 0.2, w + 2 * a.grow, l + 2 * a.grow, c[0], c[1], c[2], ry))
+            lines.append(label_line("DontCare", h + 0.2, w + 2 * a.grow, l + 2 * a.grow, x, y, z, ry))
         with open(os.path.join(tr, "label_2", frame + ".txt"), "w") as f:
             f.writelines(lines)
     for k in sorted(counts):

@@ -310,6 +310,18 @@ std::string stampString(const ros::Time& t) {
   return oss.str();
 }
 
+// A tf2 buffer call (setTransform, canTransform) that throws on a stamp decades from the buffer's (ros::Duration
+// overflows inside tf2): false, with the exception's text in *why, instead of the throw.
+template <class Call>
+bool tfCall(Call&& call, std::string* why) {
+  try {
+    return call();
+  } catch (const std::runtime_error& e) {
+    *why = e.what();
+    return false;
+  }
+}
+
 // The `number`-th message of the bag (from 1) as an M; null, with the problem listed, when it is of another type or
 // its bytes do not hold an M. The reading goes on with the next message.
 template <class M>
@@ -377,13 +389,7 @@ class BagChecker {
     for (const CloudSeen& c : clouds_) {
       if (c.frame.empty() || c.frame == fixed_frame) continue;
       std::string error;
-      bool placeable = false;
-      try {
-        placeable = tf_buffer_.canTransform(fixed_frame, c.frame, c.stamp, &error);
-      } catch (const std::runtime_error& e) {  // a stamp decades from the transforms' (ros::Duration overflows)
-        error = e.what();
-      }
-      if (!placeable) {
+      if (!tfCall([&] { return tf_buffer_.canTransform(fixed_frame, c.frame, c.stamp, &error); }, &error)) {
         problems_.add("cloud " + std::to_string(c.index) + " (stamp " + stampString(c.stamp) + "): no transform " +
                       fixed_frame + " -> " + c.frame + " at its stamp: " + error);
       }
@@ -445,15 +451,8 @@ class BagChecker {
         }
         last = t.header.stamp;
       }
-      // A stamp decades from the others overflows ros::Duration inside tf2: listed like any rejected transform.
       std::string why = "empty frame, NaN or self-transform";
-      bool set = false;
-      try {
-        set = tf_buffer_.setTransform(t, "bag", is_static);
-      } catch (const std::runtime_error& e) {
-        why = e.what();
-      }
-      if (!set) {
+      if (!tfCall([&] { return tf_buffer_.setTransform(t, "bag", is_static); }, &why)) {
         problems_.add(topic + ": transform " + t.header.frame_id + " -> " + t.child_frame_id + " at " +
                       stampString(t.header.stamp) + " rejected by tf2 (" + why + ")");
       }
